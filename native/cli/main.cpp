@@ -1,0 +1,270 @@
+// kdmesh command-line tool: encode, decode and inspect .kdm streams.
+#include <CLI/CLI.hpp>
+
+#include <chrono>
+#include <cinttypes>
+#include <cstdio>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include "kdmesh/io.h"
+#include "kdmesh/kdmesh.h"
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+bool gQuiet = false;
+
+int fail(const std::string& message) {
+  std::fprintf(stderr, "kdmesh: error: %s\n", message.c_str());
+  return 1;
+}
+
+int fail(const kdmesh::Status& status, const std::string& context) {
+  return fail(context + ": " + status.message + " [" + kdmesh::errorCodeName(status.code) + "]");
+}
+
+void note(const std::string& message) {
+  if (!gQuiet) std::fprintf(stderr, "kdmesh: %s\n", message.c_str());
+}
+
+double secondsSince(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+bool readBytes(const std::string& path, std::vector<uint8_t>& bytes, std::string& error) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) {
+    error = "cannot open " + path;
+    return false;
+  }
+  bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  if (in.bad()) {
+    error = "cannot read " + path;
+    return false;
+  }
+  return true;
+}
+
+bool writeBytes(const std::string& path, const std::vector<uint8_t>& bytes, std::string& error) {
+  std::ofstream out(path, std::ios::binary);
+  out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+  out.close();
+  if (!out) {
+    error = "cannot write " + path;
+    return false;
+  }
+  return true;
+}
+
+// Prints "phase NN%" on one stderr line, at most once per percent.
+class ProgressLine {
+ public:
+  void update(const char* phase, double fraction) {
+    if (gQuiet) return;
+    const int percent = int(fraction * 100);
+    if (phase == phase_ && percent == percent_) return;
+    phase_ = phase;
+    percent_ = percent;
+    std::fprintf(stderr, "\r%-10s %3d%%", phase, percent);
+    shown_ = true;
+  }
+  ~ProgressLine() {
+    if (shown_) std::fprintf(stderr, "\r%-16s\r", "");
+  }
+
+ private:
+  const char* phase_ = nullptr;
+  int percent_ = -1;
+  bool shown_ = false;
+};
+
+struct EncodeArgs {
+  std::string input, output;
+  int bits = 16;
+  bool exact = false;
+  size_t chunkBytes = 16 * 1024;
+  bool pointsOnly = false;
+};
+
+int runEncode(const EncodeArgs& args) {
+  const auto start = Clock::now();
+  kdmesh::Complex complex;
+  kdmesh::io::Notes notes;
+  if (auto s = kdmesh::io::readFile(args.input, complex, notes); !s.ok()) return fail(s, args.input);
+  for (const std::string& n : notes) note(args.input + ": " + n);
+  if (args.pointsOnly && complex.hasSimplices()) {
+    note("--points-only: dropping " + std::to_string(complex.simplexCount(1)) + " edges, " +
+         std::to_string(complex.simplexCount(2)) + " triangles, " +
+         std::to_string(complex.simplexCount(3)) + " tetrahedra");
+    complex.edges.clear();
+    complex.triangles.clear();
+    complex.tetrahedra.clear();
+  }
+  const double readSeconds = secondsSince(start);
+
+  kdmesh::EncodeOptions options;
+  options.bits = args.bits;
+  options.exact = args.exact;
+  options.chunkBytes = args.chunkBytes;
+  ProgressLine progress;
+  options.progress = [&](const kdmesh::EncodeProgress& p) { progress.update(p.phase, p.fraction); };
+  const auto encodeStart = Clock::now();
+  kdmesh::EncodeResult result = kdmesh::encode(complex, options);
+  const double encodeSeconds = secondsSince(encodeStart);
+  if (!result.status.ok()) return fail(result.status, "cannot encode " + args.input);
+  std::string error;
+  if (!writeBytes(args.output, result.bytes, error)) return fail(error);
+  if (!gQuiet) {
+    const double n = double(complex.vertexCount());
+    std::fprintf(stderr,
+                 "%s: %zu vertices -> %zu bytes, %.3f bits/vertex (geometry %.3f) "
+                 "[read %.3fs, encode %.3fs]\n",
+                 args.output.c_str(), complex.vertexCount(), result.bytes.size(),
+                 8.0 * double(result.bytes.size()) / n, result.cost.geometryBits / n, readSeconds,
+                 encodeSeconds);
+  }
+  return 0;
+}
+
+struct DecodeArgs {
+  std::string input, output;
+  uint64_t bytes = 0;  // 0: the whole file
+  bool asciiPly = false;
+};
+
+int runDecode(const DecodeArgs& args) {
+  std::vector<uint8_t> bytes;
+  std::string error;
+  if (!readBytes(args.input, bytes, error)) return fail(error);
+  const bool prefix = args.bytes > 0 && args.bytes < bytes.size();
+  if (prefix) bytes.resize(size_t(args.bytes));
+  kdmesh::Complex complex;
+  const auto start = Clock::now();
+  if (auto s = kdmesh::decode(bytes.data(), bytes.size(), complex, prefix); !s.ok())
+    return fail(s, args.input);
+  const double seconds = secondsSince(start);
+  kdmesh::io::WriteOptions writeOptions;
+  writeOptions.asciiPly = args.asciiPly;
+  if (auto s = kdmesh::io::writeFile(args.output, complex, writeOptions); !s.ok())
+    return fail(s, args.output);
+  if (!gQuiet)
+    std::fprintf(stderr, "%s: %zu vertices from %zu bytes%s [decode %.3fs]\n", args.output.c_str(),
+                 complex.vertexCount(), bytes.size(), prefix ? " (prefix)" : "", seconds);
+  return 0;
+}
+
+std::string jsonNumber(double v) {
+  char buffer[64];
+  std::snprintf(buffer, sizeof buffer, "%.17g", v);
+  return buffer;
+}
+
+int runInfo(const std::string& input, bool json) {
+  std::vector<uint8_t> bytes;
+  std::string error;
+  if (!readBytes(input, bytes, error)) return fail(error);
+  kdmesh::DecoderOptions options;
+  options.measureCost = true;
+  kdmesh::Decoder decoder(options);
+  if (auto s = decoder.push(bytes.data(), bytes.size()); !s.ok()) return fail(s, input);
+  if (auto s = decoder.finish(); !s.ok()) return fail(s, input);
+  const kdmesh::Header& h = decoder.header();
+  const double n = h.vertexCount;
+  const kdmesh::CodingCost cost = decoder.cost();
+  const bool grid = h.quantization == kdmesh::Quantization::Grid;
+  if (json) {
+    std::printf("{\n  \"version\": %u,\n  \"bytes\": %zu,\n  \"vertexCount\": %u,\n",
+                unsigned(h.version), bytes.size(), h.vertexCount);
+    std::printf("  \"maxDimension\": %u,\n  \"simplexCounts\": [%u, %u, %u, %u],\n",
+                unsigned(h.maxDimension), h.simplexCounts[0], h.simplexCounts[1],
+                h.simplexCounts[2], h.simplexCounts[3]);
+    std::printf("  \"quantization\": \"%s\",\n  \"bits\": %u,\n", grid ? "grid" : "float32",
+                unsigned(h.bits));
+    std::printf("  \"axisBits\": [%d, %d, %d],\n", h.axisBits(0), h.axisBits(1), h.axisBits(2));
+    if (grid)
+      std::printf("  \"origin\": [%s, %s, %s],\n  \"step\": %s,\n", jsonNumber(h.origin[0]).c_str(),
+                  jsonNumber(h.origin[1]).c_str(), jsonNumber(h.origin[2]).c_str(),
+                  jsonNumber(h.step).c_str());
+    std::printf("  \"bitsPerVertex\": {\"total\": %s, \"geometry\": %s, \"connectivity\": %s},\n",
+                jsonNumber(8.0 * double(bytes.size()) / n).c_str(),
+                jsonNumber(cost.geometryBits / n).c_str(),
+                jsonNumber(cost.connectivityBits / n).c_str());
+    std::printf("  \"chunks\": [");
+    const auto& chunks = decoder.chunks();
+    for (size_t i = 0; i < chunks.size(); ++i)
+      std::printf("%s\n    {\"offset\": %" PRIu64 ", \"payloadBytes\": %u, \"splits\": %u}",
+                  i ? "," : "", chunks[i].offset, chunks[i].payloadBytes, chunks[i].splitCount);
+    std::printf("\n  ]\n}\n");
+    return 0;
+  }
+  std::printf("kdmesh stream, format version %u, %zu bytes\n", unsigned(h.version), bytes.size());
+  std::printf("vertices        %u\n", h.vertexCount);
+  std::printf("simplices       %u points, %u edges, %u triangles, %u tetrahedra (max dim %u)\n",
+              h.simplexCounts[0], h.simplexCounts[1], h.simplexCounts[2], h.simplexCounts[3],
+              unsigned(h.maxDimension));
+  if (grid)
+    std::printf("quantization    grid, %u bits (x %d, y %d, z %d), step %.9g, origin (%.9g, %.9g, %.9g)\n",
+                unsigned(h.bits), h.axisBits(0), h.axisBits(1), h.axisBits(2), h.step, h.origin[0],
+                h.origin[1], h.origin[2]);
+  else
+    std::printf("quantization    exact float32 (x %d, y %d, z %d bits of float image)\n",
+                h.axisBits(0), h.axisBits(1), h.axisBits(2));
+  std::printf("kd-tree levels  %d\n", h.depth());
+  std::printf("bits/vertex     %.3f total: %.3f geometry, %.3f connectivity, %.3f container\n",
+              8.0 * double(bytes.size()) / n, cost.geometryBits / n, cost.connectivityBits / n,
+              (8.0 * double(bytes.size()) - cost.geometryBits - cost.connectivityBits) / n);
+  std::printf("chunks          %zu\n", decoder.chunks().size());
+  std::printf("  %5s %10s %8s %10s\n", "chunk", "offset", "payload", "splits");
+  for (size_t i = 0; i < decoder.chunks().size(); ++i) {
+    const kdmesh::ChunkInfo& c = decoder.chunks()[i];
+    std::printf("  %5zu %10" PRIu64 " %8u %10u\n", i, c.offset, c.payloadBytes, c.splitCount);
+  }
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"kdmesh: progressive lossless compression of point clouds and simplicial complexes"};
+  app.require_subcommand(1);
+  app.add_flag("-q,--quiet", gQuiet, "No progress or statistics on stderr");
+
+  EncodeArgs encodeArgs;
+  CLI::App* encode = app.add_subcommand("encode", "Compress a PLY, OBJ, OFF or XYZ file to .kdm");
+  encode->add_option("input", encodeArgs.input, "Input file (.ply .obj .off .xyz)")->required()->check(CLI::ExistingFile);
+  encode->add_option("-o,--output", encodeArgs.output, "Output .kdm file")->required();
+  auto* bits = encode->add_option("--bits", encodeArgs.bits,
+                                  "Grid bits of the longest bounding-box axis (1-30)")
+                   ->check(CLI::Range(1, 30))
+                   ->capture_default_str();
+  encode->add_flag("--exact", encodeArgs.exact, "Keep every float32 coordinate bit-exact")->excludes(bits);
+  encode->add_option("--chunk-bytes", encodeArgs.chunkBytes,
+                     "Largest chunk payload in bytes; the first chunks start at 1 KiB")
+      ->check(CLI::Range(64, 1 << 26))
+      ->capture_default_str();
+  encode->add_flag("--points-only", encodeArgs.pointsOnly,
+                   "Drop edges, triangles and tetrahedra and encode the vertices");
+
+  DecodeArgs decodeArgs;
+  CLI::App* decode = app.add_subcommand("decode", "Decompress a .kdm file (or a prefix of it)");
+  decode->add_option("input", decodeArgs.input, "Input .kdm file")->required()->check(CLI::ExistingFile);
+  decode->add_option("-o,--output", decodeArgs.output, "Output file (.ply .obj .off .xyz)")->required();
+  decode->add_option("--bytes", decodeArgs.bytes,
+                     "Decode only the first N bytes: the model as a viewer sees it after N bytes");
+  decode->add_flag("--ascii", decodeArgs.asciiPly, "Write ASCII instead of binary PLY");
+
+  std::string infoInput;
+  bool infoJson = false;
+  CLI::App* info = app.add_subcommand("info", "Describe a .kdm file: header, chunks, bits per vertex");
+  info->add_option("input", infoInput, "Input .kdm file")->required()->check(CLI::ExistingFile);
+  info->add_flag("--json", infoJson, "Machine-readable output");
+
+  CLI11_PARSE(app, argc, argv);
+  if (encode->parsed()) return runEncode(encodeArgs);
+  if (decode->parsed()) return runDecode(decodeArgs);
+  return runInfo(infoInput, infoJson);
+}

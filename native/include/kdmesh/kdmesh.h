@@ -1,0 +1,243 @@
+// kdmesh — progressive, lossless compression of simplicial complexes.
+//
+// The codec follows Gandoin & Devillers, "Progressive Lossless Compression of
+// Arbitrary Simplicial Complexes" (SIGGRAPH 2002): a kd-tree halves the
+// bounding box cell by cell and arithmetic-codes how many vertices fall in the
+// first half of every cell, coarse to fine, so that any prefix of a stream
+// decodes to a coarser model.
+//
+// This header is the whole public C++ API of the codec core. The core does no
+// file I/O and throws no exceptions; it compiles unchanged to WebAssembly,
+// where the decoder runs on untrusted bytes. File formats live in kdmesh/io.h.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace kdmesh {
+
+// ---------------------------------------------------------------------------
+// Data model
+// ---------------------------------------------------------------------------
+
+// A simplicial complex of dimension <= 3: vertex positions plus simplices of
+// each dimension as flat index arrays (2 indices per edge, 3 per triangle,
+// 4 per tetrahedron). A vertex that belongs to no edge, triangle or
+// tetrahedron is an isolated point of the complex whether or not it is listed
+// in `points`: readers fill `points` with what a file declares (OBJ `p`), the
+// encoder ignores it, and the decoder lists there every isolated vertex.
+struct Complex {
+  std::vector<float> positions;  // xyz, 3 floats per vertex
+  std::vector<uint32_t> points;
+  std::vector<uint32_t> edges;
+  std::vector<uint32_t> triangles;
+  std::vector<uint32_t> tetrahedra;
+
+  size_t vertexCount() const { return positions.size() / 3; }
+  size_t simplexCount(int dimension) const;
+  bool hasSimplices() const {
+    return !edges.empty() || !triangles.empty() || !tetrahedra.empty();
+  }
+};
+
+// ---------------------------------------------------------------------------
+// Errors
+// ---------------------------------------------------------------------------
+
+enum class ErrorCode : uint8_t {
+  Ok = 0,
+  InvalidArgument,     // an option is out of range
+  InvalidInput,        // the complex cannot be encoded (NaN, bad index, ...)
+  Unsupported,         // valid input that this version cannot encode
+  BadMagic,            // the bytes are not a kdmesh stream
+  UnsupportedVersion,  // a kdmesh stream from a newer format version
+  CorruptHeader,       // header checksum or field validation failed
+  CorruptChunk,        // chunk checksum or chunk decoding failed
+  Truncated,           // finish() was called before the stream was complete
+  TrailingBytes,       // bytes after the last chunk
+  LimitExceeded,       // the stream asks for more than DecoderLimits allow
+};
+
+// Stable lower-case name of an error code ("corrupt-chunk", ...), used by the
+// CLI and the JavaScript binding.
+const char* errorCodeName(ErrorCode code);
+
+struct Status {
+  ErrorCode code = ErrorCode::Ok;
+  std::string message;
+
+  bool ok() const { return code == ErrorCode::Ok; }
+  static Status success() { return {}; }
+  static Status error(ErrorCode code, std::string message) {
+    return {code, std::move(message)};
+  }
+};
+
+// ---------------------------------------------------------------------------
+// Stream header
+// ---------------------------------------------------------------------------
+
+enum class Quantization : uint8_t {
+  Grid = 0,     // isotropic grid over the bounding box, `bits` per longest axis
+  Float32 = 1,  // every float32 coordinate bit-exact
+};
+
+// Everything a decoder knows once the fixed-size header has arrived.
+// The layout is specified in docs/FORMAT.md.
+struct Header {
+  uint16_t version = 0;
+  Quantization quantization = Quantization::Grid;
+  uint8_t bits = 0;                 // grid bits of the longest axis (Grid)
+  uint32_t vertexCount = 0;
+  uint8_t maxDimension = 0;         // highest simplex dimension present
+  std::array<uint32_t, 4> simplexCounts{};  // per dimension 0..3; [0] counts
+                                            // isolated vertices
+  std::array<uint32_t, 3> gridMax{};  // largest integer coordinate per axis
+  std::array<double, 3> origin{};   // Grid: position of integer coordinate 0
+  double step = 0;                  // Grid: distance between grid lines
+  std::array<uint32_t, 3> floatImageMin{};  // Float32: see docs/FORMAT.md
+  uint64_t bodyBytes = 0;           // bytes after the header
+  uint32_t chunkCount = 0;
+
+  // Bits of integer coordinate per axis: the kd-tree refines axis a
+  // axisBits(a) times.
+  int axisBits(int axis) const;
+  // Number of kd-tree levels: the sum of axisBits over the three axes.
+  int depth() const;
+  // Total stream size in bytes (header plus body).
+  uint64_t totalBytes() const;
+};
+
+// Size in bytes of the fixed header that starts every stream.
+constexpr size_t kHeaderBytes = 96;
+// Size in bytes of the frame in front of every chunk's payload.
+constexpr size_t kChunkFrameBytes = 12;
+
+// ---------------------------------------------------------------------------
+// Encoding
+// ---------------------------------------------------------------------------
+
+struct EncodeProgress {
+  const char* phase;  // "quantize", "sort", "code"
+  double fraction;    // 0..1 within the phase
+};
+
+struct EncodeOptions {
+  // Grid bits of the longest bounding-box axis, 1..30. 16 bits keep the
+  // error below 1/131070 of the largest extent: finer than float32 rendering
+  // of a typical scan, and half the size of raw float32 coordinates.
+  int bits = 16;
+  // Preserve every float32 coordinate bit for bit (overrides `bits`).
+  bool exact = false;
+  // Largest chunk payload in bytes. The first chunks are smaller (1 KiB,
+  // doubling up to this size) so that a viewer can show something early.
+  size_t chunkBytes = 16 * 1024;
+  // Called now and then during long encodes; may be empty.
+  std::function<void(const EncodeProgress&)> progress;
+};
+
+// Information content of what a stream codes, in bits: the sum of -log2(p)
+// over every coded symbol, split by what the symbol describes.
+struct CodingCost {
+  double geometryBits = 0;
+  double connectivityBits = 0;
+};
+
+struct EncodeResult {
+  Status status;
+  std::vector<uint8_t> bytes;
+  CodingCost cost;
+};
+
+EncodeResult encode(const Complex& complex, const EncodeOptions& options = {});
+
+// ---------------------------------------------------------------------------
+// Decoding
+// ---------------------------------------------------------------------------
+
+// Caps that keep a hostile header from making the decoder allocate without
+// bound. Exceeding one is a LimitExceeded error, never an allocation.
+struct DecoderLimits {
+  uint32_t maxVertices = 1u << 27;
+  uint32_t maxChunkBytes = 1u << 26;
+};
+
+struct DecoderOptions {
+  DecoderLimits limits;
+  // Accumulate CodingCost while decoding (costs a little speed).
+  bool measureCost = false;
+};
+
+struct ChunkInfo {
+  uint64_t offset;        // of the chunk frame, from the start of the stream
+  uint32_t payloadBytes;
+  uint32_t splitCount;    // kd-tree cells the chunk refines
+};
+
+// Where a decoder stands in the stream.
+struct DecodeProgress {
+  uint64_t bytesReceived = 0;  // pushed so far
+  uint64_t bytesConsumed = 0;  // header plus every applied chunk
+  uint64_t bytesExpected = 0;  // whole stream, from the header (0 before it)
+  uint32_t chunksApplied = 0;
+  uint32_t level = 0;          // kd-tree level being refined (0 = root)
+  uint32_t cellCount = 0;      // vertices of the current model
+  bool complete = false;
+};
+
+// Incremental decoder. Feed it the stream in pieces of any size with push();
+// every whole chunk is applied at once and the remainder waits for more bytes.
+// The current model can be read between pushes at any time.
+//
+//   kdmesh::Decoder decoder;
+//   while (receive(piece)) {
+//     if (auto s = decoder.push(piece.data(), piece.size()); !s.ok()) fail(s);
+//     if (decoder.hasHeader()) draw(decoder.snapshot());
+//   }
+//   if (auto s = decoder.finish(); !s.ok()) fail(s);
+//
+// After an error the decoder keeps returning that error; destroy it or reset().
+class Decoder {
+ public:
+  explicit Decoder(const DecoderOptions& options = {});
+  ~Decoder();
+  Decoder(Decoder&&) noexcept;
+  Decoder& operator=(Decoder&&) noexcept;
+
+  Status push(const uint8_t* data, size_t size);
+  // Checks that the stream was complete and nothing followed it.
+  Status finish() const;
+  void reset();
+
+  bool hasHeader() const;
+  const Header& header() const;  // valid once hasHeader()
+  bool complete() const;
+  DecodeProgress progress() const;
+  const std::vector<ChunkInfo>& chunks() const;  // applied so far
+  CodingCost cost() const;  // filled when DecoderOptions::measureCost
+
+  // The model at the current level: one vertex at the centre of every
+  // current kd-tree cell (clamped to the bounding box), or, once complete,
+  // every input vertex at its exact (quantized) position. Replaces `out`.
+  void snapshot(Complex& out) const;
+  Complex snapshot() const;
+  // Half the diagonal of the largest current cell: no input vertex is
+  // farther than this from the snapshot vertex of its cell.
+  double errorBound() const;
+
+ private:
+  struct State;
+  std::unique_ptr<State> state_;
+};
+
+// Decodes a whole stream, or the longest decodable prefix of it when
+// `allowPrefix` is true (a progressive preview of the first bytes).
+Status decode(const uint8_t* data, size_t size, Complex& out,
+              bool allowPrefix = false, const DecoderOptions& options = {});
+
+}  // namespace kdmesh

@@ -1,0 +1,78 @@
+// Coding of the kd-tree counts: how many of the p vertices of a cell fall in
+// its first half, a value in [0, p].
+//
+// The value is binarised by bisection of [0, p]: each binary decision halves
+// the interval of candidates, and is coded with an adaptive model chosen by
+//   - the population p (exact up to 15, then by its power of two),
+//   - the kd-tree level (cell size relative to the sampling density),
+//   - whether the parent split sent all its vertices to one side, and
+//   - the node of the bisection tree (the decisions taken so far).
+// After six decisions the few remaining candidates of a large cell are nearly
+// equiprobable and are coded uniformly.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "range_coder.h"
+
+namespace kdmesh {
+
+class CountCoder {
+ public:
+  explicit CountCoder(int levels) : levels_(levels < 1 ? 1 : levels) {
+    models_.resize(size_t(levels_) * kParentClasses * kContextsPerLevel);
+  }
+
+  // `parentOneSided`: the parent cell's split left one half empty.
+  // On the encoder returns `firstHalf`; on the decoder returns the decoded count.
+  template <class Coder>
+  uint32_t code(Coder& coder, uint32_t population, int level, bool parentOneSided,
+                uint32_t firstHalf) {
+    BitModel* models = &models_[(size_t(level) * kParentClasses + parentOneSided) *
+                                    kContextsPerLevel +
+                                populationOffset(population)];
+    uint32_t low = 0, candidates = population + 1, node = 1;
+    while (candidates > 1) {
+      if (node >= kTreeNodes)
+        return low + coder.uniform(firstHalf - low, candidates);
+      const uint32_t lowerHalf = candidates >> 1;
+      const bool upper = coder.bit(models[node], firstHalf - low >= lowerHalf);
+      if (upper) {
+        low += lowerHalf;
+        candidates -= lowerHalf;
+      } else {
+        candidates = lowerHalf;
+      }
+      node = node * 2 + upper;
+    }
+    return low;
+  }
+
+ private:
+  static constexpr uint32_t kExactPopulations = 15;  // p = 1..15 get own models
+  static constexpr uint32_t kTreeNodes = 64;         // six bisection levels
+  static constexpr uint32_t kParentClasses = 2;
+  // Populations 1..15 need 2^ceil(log2(p+1)) nodes; larger ones, grouped by
+  // bit width 5..32, use the full tree.
+  static constexpr uint32_t kSmallNodes = 2 + 4 * 2 + 8 * 4 + 16 * 8;
+  static constexpr uint32_t kContextsPerLevel = kSmallNodes + 28 * kTreeNodes;
+
+  static uint32_t populationOffset(uint32_t p) {
+    if (p <= kExactPopulations) {
+      // Populations with the same tree size are laid out consecutively.
+      if (p == 1) return 0;
+      if (p <= 3) return 2 + (p - 2) * 4;
+      if (p <= 7) return 10 + (p - 4) * 8;
+      return 42 + (p - 8) * 16;
+    }
+    int width = 0;
+    for (uint32_t v = p; v != 0; v >>= 1) ++width;
+    return kSmallNodes + uint32_t(width - 5) * kTreeNodes;
+  }
+
+  int levels_;
+  std::vector<BitModel> models_;
+};
+
+}  // namespace kdmesh

@@ -1,0 +1,282 @@
+// The incremental decoder: buffers pushed bytes, applies every whole chunk,
+// and keeps the kd-tree's current level as flat arrays of cells.
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <optional>
+#include <string>
+
+#include "container.h"
+#include "count_coder.h"
+#include "crc32.h"
+#include "kdmesh/kdmesh.h"
+#include "quantizer.h"
+#include "range_coder.h"
+#include "split_schedule.h"
+
+namespace kdmesh {
+namespace {
+
+// A kd-tree cell: the leading bits of its integer coordinates (as many per
+// axis as the splits above it fixed) and how many vertices it holds.
+struct Cell {
+  uint32_t prefix[3];
+  uint32_t population : 31;
+  uint32_t parentOneSided : 1;
+};
+
+}  // namespace
+
+struct Decoder::State {
+  DecoderOptions options;
+  Status error;
+  std::vector<uint8_t> pending;  // received, not yet applied
+  uint64_t bytesReceived = 0;
+  uint64_t bytesConsumed = 0;
+
+  bool hasHeader = false;
+  Header header;
+  std::optional<SplitSchedule> schedule;
+  std::optional<Dequantizer> dequantizer;
+  std::optional<CountCoder> counts;
+  RangeDecoder coder;
+  std::vector<ChunkInfo> chunks;
+  CodingCost cost;
+
+  // Cells of `level` not yet split are cells[cursor..]; their children so far
+  // are in `children`, one level finer.
+  std::vector<Cell> cells, children;
+  size_t cursor = 0;
+  int level = 0;
+
+  explicit State(const DecoderOptions& o) : options(o) {}
+
+  bool complete() const { return hasHeader && level == schedule->levels; }
+
+  Status fail(Status status) {
+    error = status;
+    return status;
+  }
+
+  Status startBody() {
+    schedule.emplace(header);
+    dequantizer.emplace(header);
+    counts.emplace(schedule->levels);
+    coder.setMeasuring(options.measureCost);
+    cells.assign(1, Cell{{0, 0, 0}, header.vertexCount, 0});
+    hasHeader = true;
+    return Status::success();
+  }
+
+  Status applyChunk(const uint8_t* payload, const ChunkFrame& frame) {
+    const std::string where = "chunk " + std::to_string(chunks.size());
+    if (crc32(payload, frame.payloadBytes) != frame.checksum)
+      return Status::error(ErrorCode::CorruptChunk, where + ": checksum mismatch");
+    coder.start(payload, frame.payloadBytes);
+    for (uint32_t s = 0; s < frame.splitCount; ++s) {
+      if (complete())
+        return Status::error(ErrorCode::CorruptChunk,
+                             where + ": more splits than the kd-tree has cells");
+      splitNextCell();
+    }
+    if (coder.invalid())
+      return Status::error(ErrorCode::CorruptChunk, where + ": undecodable data");
+    cost.geometryBits = coder.cost();
+    return Status::success();
+  }
+
+  void splitNextCell() {
+    const Cell cell = cells[cursor++];
+    const uint32_t population = cell.population;
+    const uint32_t firstHalf =
+        counts->code(coder, population, level, cell.parentOneSided, 0);
+    const bool oneSided = firstHalf == 0 || firstHalf == population;
+    const int axis = schedule->axis[size_t(level)];
+    Cell child = cell;
+    child.parentOneSided = oneSided;
+    child.prefix[axis] = cell.prefix[axis] << 1;
+    if (firstHalf > 0) {
+      child.population = firstHalf;
+      children.push_back(child);
+    }
+    if (firstHalf < population) {
+      child.prefix[axis] |= 1;
+      child.population = population - firstHalf;
+      children.push_back(child);
+    }
+    if (cursor == cells.size()) {
+      std::swap(cells, children);
+      children.clear();
+      cursor = 0;
+      ++level;
+    }
+  }
+
+  // Integer coordinate range [lo, hi] along `axis` of a cell at `cellLevel`,
+  // clamped to the coded bounding box.
+  void cellRange(const Cell& cell, int cellLevel, int axis, uint32_t& lo, uint32_t& hi) const {
+    const int free = schedule->bits[size_t(axis)] - schedule->consumed[size_t(cellLevel)][size_t(axis)];
+    const uint64_t low = uint64_t(cell.prefix[axis]) << free;
+    const uint64_t high = low + ((uint64_t(1) << free) - 1);
+    lo = uint32_t(low);
+    hi = uint32_t(std::min<uint64_t>(high, header.gridMax[size_t(axis)]));
+  }
+
+  template <class Visit>
+  void forEachCurrentCell(Visit visit) const {
+    for (const Cell& c : children) visit(c, level + 1);
+    for (size_t i = cursor; i < cells.size(); ++i) visit(cells[i], level);
+  }
+
+  Status process() {
+    size_t offset = 0;
+    Status status;
+    while (status.ok()) {
+      const size_t available = pending.size() - offset;
+      const uint8_t* at = pending.data() + offset;
+      if (!hasHeader) {
+        if (available < kHeaderBytes) break;
+        status = readHeader(at, options.limits, header);
+        if (status.ok()) status = startBody();
+        offset += kHeaderBytes;
+        bytesConsumed += kHeaderBytes;
+        continue;
+      }
+      if (chunks.size() == header.chunkCount) {
+        if (available > 0)
+          status = Status::error(ErrorCode::TrailingBytes,
+                                 std::to_string(available) + " bytes after the end of the stream");
+        break;
+      }
+      if (available < kChunkFrameBytes) break;
+      const ChunkFrame frame = readChunkFrame(at);
+      const uint64_t end = bytesConsumed + kChunkFrameBytes + uint64_t(frame.payloadBytes);
+      if (frame.payloadBytes > options.limits.maxChunkBytes || end > header.totalBytes() ||
+          frame.splitCount == 0) {
+        status = Status::error(ErrorCode::CorruptChunk,
+                               "chunk " + std::to_string(chunks.size()) + ": invalid frame");
+        break;
+      }
+      if (available < kChunkFrameBytes + frame.payloadBytes) break;
+      status = applyChunk(at + kChunkFrameBytes, frame);
+      if (!status.ok()) break;
+      chunks.push_back({bytesConsumed, frame.payloadBytes, frame.splitCount});
+      offset += kChunkFrameBytes + frame.payloadBytes;
+      bytesConsumed = end;
+      if (chunks.size() == header.chunkCount && !complete())
+        status = Status::error(ErrorCode::CorruptChunk,
+                               "the last chunk ends before the kd-tree is complete");
+    }
+    pending.erase(pending.begin(), pending.begin() + std::ptrdiff_t(offset));
+    return status;
+  }
+};
+
+Decoder::Decoder(const DecoderOptions& options) : state_(std::make_unique<State>(options)) {}
+Decoder::~Decoder() = default;
+Decoder::Decoder(Decoder&&) noexcept = default;
+Decoder& Decoder::operator=(Decoder&&) noexcept = default;
+
+void Decoder::reset() { state_ = std::make_unique<State>(state_->options); }
+
+Status Decoder::push(const uint8_t* data, size_t size) {
+  State& s = *state_;
+  if (!s.error.ok()) return s.error;
+  s.bytesReceived += size;
+  s.pending.insert(s.pending.end(), data, data + size);
+  Status status = s.process();
+  return status.ok() ? status : s.fail(status);
+}
+
+Status Decoder::finish() const {
+  const State& s = *state_;
+  if (!s.error.ok()) return s.error;
+  if (!s.complete()) {
+    std::string message = "stream truncated: received " + std::to_string(s.bytesReceived) + " bytes";
+    if (s.hasHeader) message += " of " + std::to_string(s.header.totalBytes());
+    return Status::error(ErrorCode::Truncated, message);
+  }
+  return Status::success();
+}
+
+bool Decoder::hasHeader() const { return state_->hasHeader; }
+const Header& Decoder::header() const { return state_->header; }
+bool Decoder::complete() const { return state_->complete(); }
+const std::vector<ChunkInfo>& Decoder::chunks() const { return state_->chunks; }
+CodingCost Decoder::cost() const { return state_->cost; }
+
+DecodeProgress Decoder::progress() const {
+  const State& s = *state_;
+  DecodeProgress p;
+  p.bytesReceived = s.bytesReceived;
+  p.bytesConsumed = s.bytesConsumed;
+  p.bytesExpected = s.hasHeader ? s.header.totalBytes() : 0;
+  p.chunksApplied = uint32_t(s.chunks.size());
+  p.level = uint32_t(s.level);
+  p.complete = s.complete();
+  if (s.hasHeader)
+    p.cellCount = uint32_t(p.complete ? s.header.vertexCount
+                                      : s.children.size() + s.cells.size() - s.cursor);
+  return p;
+}
+
+void Decoder::snapshot(Complex& out) const {
+  const State& s = *state_;
+  out = Complex{};
+  if (!s.hasHeader) return;
+  const bool complete = s.complete();
+  out.positions.reserve(size_t(complete ? s.header.vertexCount : progress().cellCount) * 3);
+  s.forEachCurrentCell([&](const Cell& cell, int cellLevel) {
+    float position[3];
+    for (int a = 0; a < 3; ++a) {
+      uint32_t lo, hi;
+      s.cellRange(cell, cellLevel, a, lo, hi);
+      position[a] = s.dequantizer->position(a, lo, hi);
+    }
+    // A finished cell holds coincident vertices; before that it is one vertex.
+    const uint32_t copies = complete ? cell.population : 1;
+    for (uint32_t i = 0; i < copies; ++i) out.positions.insert(out.positions.end(), position, position + 3);
+  });
+  const uint32_t n = uint32_t(out.vertexCount());
+  out.points.resize(n);
+  for (uint32_t i = 0; i < n; ++i) out.points[i] = i;
+}
+
+Complex Decoder::snapshot() const {
+  Complex c;
+  snapshot(c);
+  return c;
+}
+
+double Decoder::errorBound() const {
+  const State& s = *state_;
+  if (!s.hasHeader) return INFINITY;
+  const double halfStep = s.header.quantization == Quantization::Grid ? s.header.step * 0.5 : 0;
+  double worst = 0;
+  s.forEachCurrentCell([&](const Cell& cell, int cellLevel) {
+    double squared = 0;
+    for (int a = 0; a < 3; ++a) {
+      uint32_t lo, hi;
+      s.cellRange(cell, cellLevel, a, lo, hi);
+      const double half =
+          (double(s.dequantizer->position(a, hi, hi)) - double(s.dequantizer->position(a, lo, lo))) * 0.5 +
+          halfStep;
+      squared += half * half;
+    }
+    worst = std::max(worst, squared);
+  });
+  return std::sqrt(worst);
+}
+
+Status decode(const uint8_t* data, size_t size, Complex& out, bool allowPrefix,
+              const DecoderOptions& options) {
+  Decoder decoder(options);
+  Status status = decoder.push(data, size);
+  if (!status.ok()) return status;
+  if (!allowPrefix)
+    if (status = decoder.finish(); !status.ok()) return status;
+  decoder.snapshot(out);
+  return Status::success();
+}
+
+}  // namespace kdmesh

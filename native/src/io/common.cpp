@@ -1,0 +1,254 @@
+#include <charconv>
+#include <cstring>
+#include <limits>
+
+#include "io/io_internal.h"
+
+namespace kdmesh::io::detail {
+
+// ---------------------------------------------------------------------------
+// TextScanner
+// ---------------------------------------------------------------------------
+
+TextScanner::TextScanner(const uint8_t* data, size_t size, TextSyntax syntax)
+    : begin_(reinterpret_cast<const char*>(data)),
+      end_(begin_ + size),
+      cursor_(begin_),
+      lineEnd_(begin_),
+      next_(begin_),
+      syntax_(syntax) {}
+
+bool TextScanner::nextLine() {
+  if (next_ == end_) {
+    cursor_ = lineEnd_ = end_;
+    return false;
+  }
+  cursor_ = next_;
+  const void* newline = std::memchr(cursor_, '\n', end_ - cursor_);
+  lineEnd_ = newline ? static_cast<const char*>(newline) : end_;
+  next_ = newline ? lineEnd_ + 1 : end_;
+  ++line_;
+  return true;
+}
+
+bool TextScanner::nextContentLine() {
+  while (nextLine()) {
+    while (cursor_ < lineEnd_ && isSeparator(*cursor_)) ++cursor_;
+    if (cursor_ < lineEnd_ && !(syntax_.hashComments && *cursor_ == '#')) {
+      return true;
+    }
+  }
+  return false;
+}
+
+bool TextScanner::nextToken(std::string_view& token) {
+  while (cursor_ < lineEnd_ && isSeparator(*cursor_)) ++cursor_;
+  if (cursor_ == lineEnd_ || (syntax_.hashComments && *cursor_ == '#')) {
+    cursor_ = lineEnd_;
+    return false;
+  }
+  const char* start = cursor_;
+  while (cursor_ < lineEnd_ && !endsToken(*cursor_)) ++cursor_;
+  token = std::string_view(start, cursor_ - start);
+  return true;
+}
+
+bool TextScanner::nextTokenAcrossLines(std::string_view& token) {
+  while (!nextToken(token)) {
+    if (!nextLine()) return false;
+  }
+  return true;
+}
+
+// ---------------------------------------------------------------------------
+// Numbers
+// ---------------------------------------------------------------------------
+
+namespace {
+
+// from_chars rejects the '+' that many writers put in front of numbers.
+std::string_view withoutPlus(std::string_view token) {
+  if (token.size() > 1 && token[0] == '+' && token[1] != '-' &&
+      token[1] != '+') {
+    token.remove_prefix(1);
+  }
+  return token;
+}
+
+bool isDigit(char c) { return c >= '0' && c <= '9'; }
+
+// Power of ten of the leading digit of a decimal number in from_chars syntax,
+// saturated far beyond float range.
+int64_t decimalMagnitude(std::string_view number) {
+  size_t i = number[0] == '-' ? 1 : 0;
+  int64_t integerDigits = 0;
+  for (; i < number.size() && isDigit(number[i]); ++i) {
+    if (integerDigits > 0 || number[i] != '0') ++integerDigits;
+  }
+  int64_t fractionZeros = 0;
+  if (i < number.size() && number[i] == '.') {
+    bool significant = integerDigits > 0;
+    for (++i; i < number.size() && isDigit(number[i]); ++i) {
+      significant = significant || number[i] != '0';
+      if (!significant) ++fractionZeros;
+    }
+  }
+  int64_t magnitude =
+      integerDigits > 0 ? integerDigits - 1 : -(fractionZeros + 1);
+  if (i < number.size() && (number[i] == 'e' || number[i] == 'E')) {
+    std::string_view exponentText = withoutPlus(number.substr(i + 1));
+    int64_t exponent = 0;
+    auto result = std::from_chars(
+        exponentText.data(), exponentText.data() + exponentText.size(),
+        exponent);
+    if (result.ec == std::errc::result_out_of_range) {
+      exponent = exponentText[0] == '-' ? -(int64_t{1} << 40)
+                                        : (int64_t{1} << 40);
+    }
+    magnitude += exponent;
+  }
+  return magnitude;
+}
+
+// from_chars reports a value beyond float range without giving one; rounding
+// to nearest takes it to infinity when too large and to zero when too small.
+float roundOutOfRange(std::string_view number) {
+  float magnitude = decimalMagnitude(number) >= 0
+                        ? std::numeric_limits<float>::infinity()
+                        : 0.0f;
+  return number[0] == '-' ? -magnitude : magnitude;
+}
+
+}  // namespace
+
+bool parseFloat(std::string_view token, float& value) {
+  token = withoutPlus(token);
+  const char* end = token.data() + token.size();
+  auto [stop, error] = std::from_chars(token.data(), end, value);
+  if (stop != end) return false;
+  if (error == std::errc::result_out_of_range) {
+    value = roundOutOfRange(token);
+    return true;
+  }
+  return error == std::errc();
+}
+
+bool parseInteger(std::string_view token, int64_t& value) {
+  token = withoutPlus(token);
+  const char* end = token.data() + token.size();
+  auto [stop, error] = std::from_chars(token.data(), end, value);
+  return stop == end && error == std::errc();
+}
+
+bool parseCount(std::string_view token, uint64_t& value) {
+  token = withoutPlus(token);
+  const char* end = token.data() + token.size();
+  auto [stop, error] = std::from_chars(token.data(), end, value);
+  return stop == end && error == std::errc();
+}
+
+Status readPositionLine(TextScanner& scanner, std::vector<float>& positions,
+                        bool& extraColumns) {
+  float xyz[3];
+  std::string_view token;
+  for (int axis = 0; axis < 3; ++axis) {
+    if (!scanner.nextToken(token)) {
+      return lineError(scanner.lineNumber(),
+                       "vertex has " + std::to_string(axis) +
+                           " coordinates, needs 3");
+    }
+    if (!parseFloat(token, xyz[axis])) {
+      return lineError(scanner.lineNumber(),
+                       quoted(token) + " is not a number");
+    }
+  }
+  positions.insert(positions.end(), xyz, xyz + 3);
+  extraColumns = scanner.nextToken(token);
+  return Status::success();
+}
+
+std::string quoted(std::string_view token) {
+  constexpr size_t kMaxShown = 40;
+  if (token.size() > kMaxShown) {
+    return "'" + std::string(token.substr(0, kMaxShown)) + "...'";
+  }
+  return "'" + std::string(token) + "'";
+}
+
+Status inputError(std::string message) {
+  return Status::error(ErrorCode::InvalidInput, std::move(message));
+}
+
+Status lineError(size_t line, const std::string& message) {
+  return inputError("line " + std::to_string(line) + ": " + message);
+}
+
+bool takeFromBudget(uint64_t count, uint64_t minBytesEach, uint64_t& budget) {
+  if (minBytesEach == 0) return true;
+  if (count > budget / minBytesEach) return false;
+  budget -= count * minBytesEach;
+  return true;
+}
+
+// ---------------------------------------------------------------------------
+// Polygons and notes
+// ---------------------------------------------------------------------------
+
+void PolygonSplit::append(const uint32_t* polygon, size_t size,
+                          std::vector<uint32_t>& out) {
+  for (size_t i = 1; i + 1 < size; ++i) {
+    out.insert(out.end(), {polygon[0], polygon[i], polygon[i + 1]});
+  }
+  if (size > 3) {
+    ++polygons;
+    triangles += size - 2;
+  }
+}
+
+void PolygonSplit::addNote(Notes& notes) const {
+  if (polygons == 0) return;
+  notes.push_back("split " + std::to_string(polygons) +
+                  " polygons with more than 3 vertices into " +
+                  std::to_string(triangles) + " triangles");
+}
+
+void addCountNote(Notes& notes, const char* before, size_t count,
+                  const char* after) {
+  if (count == 0) return;
+  notes.push_back(before + std::to_string(count) + after);
+}
+
+// ---------------------------------------------------------------------------
+// TextOut
+// ---------------------------------------------------------------------------
+
+void TextOut::separate() {
+  if (!lineStart_) out_.push_back(' ');
+  lineStart_ = false;
+}
+
+TextOut& TextOut::word(std::string_view text) {
+  separate();
+  out_.insert(out_.end(), text.begin(), text.end());
+  return *this;
+}
+
+TextOut& TextOut::real(float value) {
+  char buffer[32];
+  auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
+  return word(std::string_view(buffer, result.ptr - buffer));
+}
+
+TextOut& TextOut::integer(uint64_t value) {
+  char buffer[24];
+  auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
+  return word(std::string_view(buffer, result.ptr - buffer));
+}
+
+TextOut& TextOut::endLine() {
+  out_.push_back('\n');
+  lineStart_ = true;
+  return *this;
+}
+
+}  // namespace kdmesh::io::detail

@@ -1,0 +1,207 @@
+// Format dispatch and file access for kdmesh/io.h.
+#include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <memory>
+
+#include "io/io_internal.h"
+
+namespace kdmesh::io {
+
+using detail::inputError;
+
+namespace {
+
+struct FileCloser {
+  void operator()(std::FILE* file) const { std::fclose(file); }
+};
+using FilePtr = std::unique_ptr<std::FILE, FileCloser>;
+
+Status fileError(const char* action, const std::string& path) {
+  return Status::error(ErrorCode::InvalidArgument, std::string(action) + " " +
+                                                       path + ": " +
+                                                       std::strerror(errno));
+}
+
+bool isBlank(const uint8_t* data, size_t size) {
+  for (size_t i = 0; i < size; ++i) {
+    switch (data[i]) {
+      case ' ': case '\t': case '\r': case '\n': case '\v': case '\f': break;
+      default: return false;
+    }
+  }
+  return true;
+}
+
+// Names the first simplex with an index past the last vertex, so that no
+// writer has to guard against them.
+Status checkIndices(const std::vector<uint32_t>& indices, size_t arity,
+                    size_t vertexCount, const char* simplexName) {
+  if (indices.size() % arity != 0) {
+    return inputError(std::string(simplexName) + " indices hold " +
+                      std::to_string(indices.size()) +
+                      " values, not a multiple of " + std::to_string(arity));
+  }
+  for (size_t i = 0; i < indices.size(); ++i) {
+    if (indices[i] >= vertexCount) {
+      return inputError(std::string(simplexName) + " " +
+                        std::to_string(i / arity) + " refers to vertex " +
+                        std::to_string(indices[i]) + ", but there are " +
+                        std::to_string(vertexCount) + " vertices");
+    }
+  }
+  return Status::success();
+}
+
+Status checkWritable(const Complex& complex) {
+  if (complex.positions.size() % 3 != 0) {
+    return inputError("positions hold " +
+                      std::to_string(complex.positions.size()) +
+                      " floats, not a multiple of 3");
+  }
+  const size_t vertexCount = complex.vertexCount();
+  for (Status status :
+       {checkIndices(complex.points, 1, vertexCount, "point"),
+        checkIndices(complex.edges, 2, vertexCount, "edge"),
+        checkIndices(complex.triangles, 3, vertexCount, "triangle"),
+        checkIndices(complex.tetrahedra, 4, vertexCount, "tetrahedron")}) {
+    if (!status.ok()) return status;
+  }
+  return Status::success();
+}
+
+Status unknownFormat(const std::string& path) {
+  return Status::error(ErrorCode::InvalidArgument,
+                       "cannot tell the format of " + path +
+                           " from its extension (expected .ply, .obj, "
+                           ".off, .xyz, .txt or .pts)");
+}
+
+}  // namespace
+
+Format formatFromPath(const std::string& path) {
+  const size_t dot = path.find_last_of('.');
+  const size_t slash = path.find_last_of("/\\");
+  if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) {
+    return Format::Unknown;
+  }
+  std::string extension = path.substr(dot + 1);
+  for (char& c : extension) {
+    if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
+  }
+  if (extension == "ply") return Format::Ply;
+  if (extension == "obj") return Format::Obj;
+  if (extension == "off") return Format::Off;
+  if (extension == "xyz" || extension == "txt" || extension == "pts") {
+    return Format::Xyz;
+  }
+  return Format::Unknown;
+}
+
+const char* formatName(Format format) {
+  switch (format) {
+    case Format::Ply: return "ply";
+    case Format::Obj: return "obj";
+    case Format::Off: return "off";
+    case Format::Xyz: return "xyz";
+    case Format::Unknown: break;
+  }
+  return "unknown";
+}
+
+Status readMemory(Format format, const uint8_t* data, size_t size,
+                  Complex& out, Notes& notes) {
+  out = Complex{};
+  if (format == Format::Unknown) {
+    return Status::error(ErrorCode::InvalidArgument, "unknown file format");
+  }
+  if (isBlank(data, size)) return inputError("file is empty");
+  Status status;
+  switch (format) {
+    case Format::Ply: status = detail::readPly(data, size, out, notes); break;
+    case Format::Obj: status = detail::readObj(data, size, out, notes); break;
+    case Format::Off: status = detail::readOff(data, size, out, notes); break;
+    case Format::Xyz: status = detail::readXyz(data, size, out, notes); break;
+    case Format::Unknown: break;
+  }
+  if (!status.ok()) out = Complex{};
+  return status;
+}
+
+Status readFile(const std::string& path, Complex& out, Notes& notes) {
+  const Format format = formatFromPath(path);
+  if (format == Format::Unknown) return unknownFormat(path);
+  FilePtr file(std::fopen(path.c_str(), "rb"));
+  if (!file) return fileError("cannot open", path);
+
+  // Read in growing blocks rather than trusting a size from fseek/ftell, which
+  // pipes and special files do not give.
+  std::vector<uint8_t> bytes;
+  size_t used = 0;
+  for (size_t block = 1 << 16;; block = std::min<size_t>(block * 2, 1 << 26)) {
+    bytes.resize(used + block);
+    const size_t got = std::fread(bytes.data() + used, 1, block, file.get());
+    used += got;
+    if (got < block) break;
+  }
+  if (std::ferror(file.get())) return fileError("cannot read", path);
+  bytes.resize(used);
+  return readMemory(format, bytes.data(), bytes.size(), out, notes);
+}
+
+Status writeMemory(Format format, const Complex& complex,
+                   std::vector<uint8_t>& out, const WriteOptions& options) {
+  out.clear();
+  if (format == Format::Unknown) {
+    return Status::error(ErrorCode::InvalidArgument, "unknown file format");
+  }
+  if (Status status = checkWritable(complex); !status.ok()) return status;
+  Status status;
+  switch (format) {
+    case Format::Ply: status = detail::writePly(complex, out, options); break;
+    case Format::Obj: status = detail::writeObj(complex, out); break;
+    case Format::Off: status = detail::writeOff(complex, out); break;
+    case Format::Xyz: status = detail::writeXyz(complex, out); break;
+    case Format::Unknown: break;
+  }
+  if (!status.ok()) out.clear();
+  return status;
+}
+
+Status writeFile(const std::string& path, const Complex& complex,
+                 const WriteOptions& options) {
+  const Format format = formatFromPath(path);
+  if (format == Format::Unknown) return unknownFormat(path);
+  std::vector<uint8_t> bytes;
+  if (Status status = writeMemory(format, complex, bytes, options);
+      !status.ok()) {
+    return status;
+  }
+  FilePtr file(std::fopen(path.c_str(), "wb"));
+  if (!file) return fileError("cannot open", path);
+  const size_t written = std::fwrite(bytes.data(), 1, bytes.size(), file.get());
+  // fclose flushes, so its result decides whether the bytes reached the file.
+  if (written != bytes.size() || std::fclose(file.release()) != 0) {
+    return fileError("cannot write", path);
+  }
+  return Status::success();
+}
+
+namespace detail {
+
+bool pointsAreImplicit(const Complex& complex) {
+  if (complex.points.empty()) return true;
+  std::vector<uint8_t> used(complex.vertexCount(), 0);
+  for (const auto* indices :
+       {&complex.edges, &complex.triangles, &complex.tetrahedra}) {
+    for (uint32_t vertex : *indices) used[vertex] = 1;
+  }
+  for (uint32_t point : complex.points) {
+    if (used[point]) return false;
+  }
+  return true;
+}
+
+}  // namespace detail
+}  // namespace kdmesh::io

@@ -1,0 +1,124 @@
+#include "quantizer.h"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstring>
+#include <string>
+
+namespace kdmesh {
+namespace {
+
+uint32_t floatBits(float f) {
+  uint32_t u;
+  std::memcpy(&u, &f, 4);
+  return u;
+}
+
+float bitsToFloat(uint32_t u) {
+  float f;
+  std::memcpy(&f, &u, 4);
+  return f;
+}
+
+uint32_t orderedImage(float f) {
+  const uint32_t u = floatBits(f);
+  return (u & 0x80000000u) ? ~u : (u | 0x80000000u);
+}
+
+float fromOrderedImage(uint32_t image) {
+  return bitsToFloat((image & 0x80000000u) ? (image ^ 0x80000000u) : ~image);
+}
+
+Status checkFinite(const std::vector<float>& positions) {
+  for (size_t i = 0; i < positions.size(); ++i) {
+    if (!std::isfinite(positions[i])) {
+      static const char* kAxis = "xyz";
+      return Status::error(ErrorCode::InvalidInput,
+                           "vertex " + std::to_string(i / 3) + " has a " +
+                               (std::isnan(positions[i]) ? "NaN" : "infinite") + " " +
+                               kAxis[i % 3] + " coordinate");
+    }
+  }
+  return Status::success();
+}
+
+void quantizeFloat32(const std::vector<float>& positions, Header& header,
+                     std::vector<uint32_t>& coords) {
+  const size_t n = positions.size() / 3;
+  std::array<uint32_t, 3> lo{0xffffffffu, 0xffffffffu, 0xffffffffu}, hi{0, 0, 0};
+  for (size_t i = 0; i < n * 3; ++i) {
+    const uint32_t image = orderedImage(positions[i]);
+    lo[i % 3] = std::min(lo[i % 3], image);
+    hi[i % 3] = std::max(hi[i % 3], image);
+  }
+  header.quantization = Quantization::Float32;
+  header.bits = 32;
+  for (int a = 0; a < 3; ++a) {
+    header.floatImageMin[size_t(a)] = lo[size_t(a)];
+    header.gridMax[size_t(a)] = hi[size_t(a)] - lo[size_t(a)];
+  }
+  coords.resize(n * 3);
+  for (size_t i = 0; i < n * 3; ++i) coords[i] = orderedImage(positions[i]) - lo[i % 3];
+}
+
+void quantizeGrid(const std::vector<float>& positions, int bits, Header& header,
+                  std::vector<uint32_t>& coords) {
+  const size_t n = positions.size() / 3;
+  std::array<float, 3> lo{positions[0], positions[1], positions[2]}, hi = lo;
+  for (size_t i = 0; i < n * 3; ++i) {
+    lo[i % 3] = std::min(lo[i % 3], positions[i]);
+    hi[i % 3] = std::max(hi[i % 3], positions[i]);
+  }
+  // Differences of floats are computed in double the same way for the extent
+  // and for every vertex, so rounding stays monotone and no coordinate can
+  // exceed gridMax.
+  std::array<double, 3> extent{};
+  double longest = 0;
+  for (int a = 0; a < 3; ++a) {
+    extent[size_t(a)] = double(hi[size_t(a)]) - double(lo[size_t(a)]);
+    longest = std::max(longest, extent[size_t(a)]);
+  }
+  double step = longest / double((uint32_t(1) << bits) - 1);
+  if (longest > 0 && step == 0) step = longest;  // extent in the denormals
+  header.quantization = Quantization::Grid;
+  header.bits = uint8_t(bits);
+  header.step = step;
+  for (int a = 0; a < 3; ++a) {
+    header.origin[size_t(a)] = lo[size_t(a)];
+    header.gridMax[size_t(a)] = step > 0 ? uint32_t(std::llround(extent[size_t(a)] / step)) : 0;
+  }
+  coords.resize(n * 3);
+  for (size_t i = 0; i < n * 3; ++i) {
+    const double offset = double(positions[i]) - double(lo[i % 3]);
+    coords[i] = step > 0 ? uint32_t(std::llround(offset / step)) : 0;
+  }
+}
+
+}  // namespace
+
+Status quantize(const std::vector<float>& positions, const EncodeOptions& options,
+                Header& header, std::vector<uint32_t>& coords) {
+  if (Status s = checkFinite(positions); !s.ok()) return s;
+  if (options.exact)
+    quantizeFloat32(positions, header, coords);
+  else
+    quantizeGrid(positions, options.bits, header, coords);
+  return Status::success();
+}
+
+Dequantizer::Dequantizer(const Header& header) : header_(header) {}
+
+float Dequantizer::position(int axis, uint32_t lo, uint32_t hi) const {
+  const size_t a = size_t(axis);
+  if (header_.quantization == Quantization::Float32) {
+    const uint32_t base = header_.floatImageMin[a];
+    const float low = fromOrderedImage(base + lo);
+    if (lo == hi) return low;
+    return float((double(low) + double(fromOrderedImage(base + hi))) * 0.5);
+  }
+  const double centre = (double(lo) + double(hi)) * 0.5;
+  return float(header_.origin[a] + centre * header_.step);
+}
+
+}  // namespace kdmesh
