@@ -2,10 +2,13 @@
 #include <CLI/CLI.hpp>
 
 #include <chrono>
+#include <cmath>
 #include <cinttypes>
 #include <cstdio>
+#include <exception>
 #include <fstream>
 #include <iterator>
+#include <new>
 #include <string>
 #include <vector>
 
@@ -17,9 +20,27 @@ namespace {
 using Clock = std::chrono::steady_clock;
 
 bool gQuiet = false;
+// Whether a progress line is on screen; anything else printed to stderr must
+// clear it first, or the message would start in the middle of that line.
+bool gProgressShown = false;
+
+void clearProgress() {
+  if (!gProgressShown) return;
+  std::fprintf(stderr, "\r%-16s\r", "");
+  gProgressShown = false;
+}
+
+// Error messages are one line, whatever the text they quote.
+std::string oneLine(std::string text) {
+  while (!text.empty() && (text.back() == '\n' || text.back() == '\r')) text.pop_back();
+  for (char& c : text)
+    if (c == '\n' || c == '\r') c = ' ';
+  return text;
+}
 
 int fail(const std::string& message) {
-  std::fprintf(stderr, "kdmesh: error: %s\n", message.c_str());
+  clearProgress();
+  std::fprintf(stderr, "kdmesh: error: %s\n", oneLine(message).c_str());
   return 1;
 }
 
@@ -28,7 +49,9 @@ int fail(const kdmesh::Status& status, const std::string& context) {
 }
 
 void note(const std::string& message) {
-  if (!gQuiet) std::fprintf(stderr, "kdmesh: %s\n", message.c_str());
+  if (gQuiet) return;
+  clearProgress();
+  std::fprintf(stderr, "kdmesh: %s\n", message.c_str());
 }
 
 double secondsSince(Clock::time_point start) {
@@ -70,16 +93,13 @@ class ProgressLine {
     phase_ = phase;
     percent_ = percent;
     std::fprintf(stderr, "\r%-10s %3d%%", phase, percent);
-    shown_ = true;
+    gProgressShown = true;
   }
-  ~ProgressLine() {
-    if (shown_) std::fprintf(stderr, "\r%-16s\r", "");
-  }
+  ~ProgressLine() { clearProgress(); }
 
  private:
   const char* phase_ = nullptr;
   int percent_ = -1;
-  bool shown_ = false;
 };
 
 struct EncodeArgs {
@@ -157,7 +177,9 @@ int runDecode(const DecodeArgs& args) {
   return 0;
 }
 
+// JSON has no inf or nan: those (from an empty model) print as null.
 std::string jsonNumber(double v) {
+  if (!std::isfinite(v)) return "null";
   char buffer[64];
   std::snprintf(buffer, sizeof buffer, "%.17g", v);
   return buffer;
@@ -231,6 +253,10 @@ int runInfo(const std::string& input, bool json) {
 int main(int argc, char** argv) {
   CLI::App app{"kdmesh: progressive lossless compression of point clouds and simplicial complexes"};
   app.require_subcommand(1);
+  // Lets the subcommands pass options they do not know, such as --quiet, to
+  // the main command: `kdmesh encode -q ...` works as well as `kdmesh -q encode ...`.
+  // Inherited by the subcommands added below.
+  app.fallthrough();
   app.add_flag("-q,--quiet", gQuiet, "No progress or statistics on stderr");
 
   EncodeArgs encodeArgs;
@@ -263,8 +289,22 @@ int main(int argc, char** argv) {
   info->add_option("input", infoInput, "Input .kdm file")->required()->check(CLI::ExistingFile);
   info->add_flag("--json", infoJson, "Machine-readable output");
 
-  CLI11_PARSE(app, argc, argv);
-  if (encode->parsed()) return runEncode(encodeArgs);
-  if (decode->parsed()) return runDecode(decodeArgs);
-  return runInfo(infoInput, infoJson);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // --help and friends: CLI11 prints them and exits 0.
+    if (e.get_exit_code() == 0) return app.exit(e);
+    // Usage errors get the same one-line form as every other error.
+    fail(std::string(e.what()) + " (run with --help for usage)");
+    return e.get_exit_code();
+  }
+  try {
+    if (encode->parsed()) return runEncode(encodeArgs);
+    if (decode->parsed()) return runDecode(decodeArgs);
+    return runInfo(infoInput, infoJson);
+  } catch (const std::bad_alloc&) {
+    return fail("out of memory");
+  } catch (const std::exception& e) {
+    return fail(e.what());
+  }
 }

@@ -24,6 +24,15 @@ class CountCoder {
     models_.resize(size_t(levels_) * kParentClasses * kContextsPerLevel);
   }
 
+  // The count of a one-vertex cell, 1 when the vertex is in the first half;
+  // the same model as code() with population 1, in a loop-free form.
+  template <class Coder>
+  bool codeSingle(Coder& coder, int level, bool parentOneSided, bool inFirstHalf) {
+    return coder.bit(models_[(size_t(level) * kParentClasses + parentOneSided) *
+                                 kContextsPerLevel + 1],
+                     inFirstHalf);
+  }
+
   // `parentOneSided`: the parent cell's split left one half empty.
   // On the encoder returns `firstHalf`; on the decoder returns the decoded count.
   template <class Coder>

@@ -23,6 +23,9 @@ struct Cell {
   uint32_t prefix[3];
   uint32_t population : 31;
   uint32_t parentOneSided : 1;
+  // How many one-vertex cells precede this cell in kd-tree order; for a new
+  // one-vertex cell, where it goes among those of the previous level.
+  uint32_t singlesBefore;
 };
 
 }  // namespace
@@ -43,10 +46,16 @@ struct Decoder::State {
   std::vector<ChunkInfo> chunks;
   CodingCost cost;
 
-  // Cells of `level` not yet split are cells[cursor..]; their children so far
-  // are in `children`, one level finer.
-  std::vector<Cell> cells, children;
-  size_t cursor = 0;
+  // Cells of `level` holding several vertices that are not yet split are
+  // cells[cursor..]; their children so far are in `children`, one level
+  // finer. Cells of one vertex live in `singles`, in kd-tree order, and are
+  // refined in place after the other cells of the level (so one level costs
+  // no copy of them): singles[singleCursor..singleLevelEnd) are still at
+  // `level`, the rest one level finer. One-vertex children born during the
+  // level wait in `newSingles` and are merged in at its end; keeping kd-tree
+  // order lets the adaptive models follow local regularity.
+  std::vector<Cell> cells, children, singles, newSingles;
+  size_t cursor = 0, singleCursor = 0, singleLevelEnd = 0;
   int level = 0;
 
   explicit State(const DecoderOptions& o) : options(o) {}
@@ -63,7 +72,9 @@ struct Decoder::State {
     dequantizer.emplace(header);
     counts.emplace(schedule->levels);
     coder.setMeasuring(options.measureCost);
-    cells.assign(1, Cell{{0, 0, 0}, header.vertexCount, 0});
+    const Cell root{{0, 0, 0}, header.vertexCount, 0, 0};
+    (header.vertexCount == 1 ? singles : cells).push_back(root);
+    singleLevelEnd = singles.size();
     hasHeader = true;
     return Status::success();
   }
@@ -73,11 +84,20 @@ struct Decoder::State {
     if (crc32(payload, frame.payloadBytes) != frame.checksum)
       return Status::error(ErrorCode::CorruptChunk, where + ": checksum mismatch");
     coder.start(payload, frame.payloadBytes);
-    for (uint32_t s = 0; s < frame.splitCount; ++s) {
+    for (uint32_t left = frame.splitCount; left > 0;) {
       if (complete())
         return Status::error(ErrorCode::CorruptChunk,
                              where + ": more splits than the kd-tree has cells");
-      splitNextCell();
+      if (cursor < cells.size()) {
+        splitCell(cells[cursor++]);
+        --left;
+      } else {
+        const size_t count = std::min<size_t>(left, singleLevelEnd - singleCursor);
+        refineSingles(singleCursor, singleCursor + count);
+        singleCursor += count;
+        left -= uint32_t(count);
+      }
+      if (cursor == cells.size() && singleCursor == singleLevelEnd) nextLevel();
     }
     if (coder.invalid())
       return Status::error(ErrorCode::CorruptChunk, where + ": undecodable data");
@@ -85,31 +105,54 @@ struct Decoder::State {
     return Status::success();
   }
 
-  void splitNextCell() {
-    const Cell cell = cells[cursor++];
+  void splitCell(const Cell& cell) {
     const uint32_t population = cell.population;
-    const uint32_t firstHalf =
-        counts->code(coder, population, level, cell.parentOneSided, 0);
+    const uint32_t firstHalf = counts->code(coder, population, level, cell.parentOneSided, 0);
     const bool oneSided = firstHalf == 0 || firstHalf == population;
     const int axis = schedule->axis[size_t(level)];
     Cell child = cell;
     child.parentOneSided = oneSided;
     child.prefix[axis] = cell.prefix[axis] << 1;
-    if (firstHalf > 0) {
-      child.population = firstHalf;
-      children.push_back(child);
-    }
-    if (firstHalf < population) {
+    for (const uint32_t half : {firstHalf, population - firstHalf}) {
+      if (half == 1) {
+        child.population = 1;
+        child.singlesBefore = cell.singlesBefore;
+        newSingles.push_back(child);
+      } else if (half > 1) {
+        child.population = half;
+        child.singlesBefore = cell.singlesBefore + uint32_t(newSingles.size());
+        children.push_back(child);
+      }
       child.prefix[axis] |= 1;
-      child.population = population - firstHalf;
-      children.push_back(child);
     }
-    if (cursor == cells.size()) {
-      std::swap(cells, children);
-      children.clear();
-      cursor = 0;
-      ++level;
+  }
+
+  void refineSingles(size_t begin, size_t end) {
+    const int axis = schedule->axis[size_t(level)];
+    for (size_t i = begin; i < end; ++i) {
+      Cell& cell = singles[i];
+      const bool upperHalf = !counts->codeSingle(coder, level, cell.parentOneSided, false);
+      cell.prefix[axis] = cell.prefix[axis] << 1 | upperHalf;
+      cell.parentOneSided = 1;
     }
+  }
+
+  void nextLevel() {
+    // Merge from the back, so that each one-vertex cell moves once.
+    size_t old = singles.size(), out = old + newSingles.size();
+    singles.resize(out);
+    for (size_t j = newSingles.size(); j > 0; --j) {
+      for (const size_t insertAt = newSingles[j - 1].singlesBefore; old > insertAt;)
+        singles[--out] = singles[--old];
+      singles[--out] = newSingles[j - 1];
+    }
+    newSingles.clear();
+    std::swap(cells, children);
+    children.clear();
+    cursor = 0;
+    singleCursor = 0;
+    singleLevelEnd = singles.size();
+    ++level;
   }
 
   // Integer coordinate range [lo, hi] along `axis` of a cell at `cellLevel`,
@@ -126,14 +169,19 @@ struct Decoder::State {
   void forEachCurrentCell(Visit visit) const {
     for (const Cell& c : children) visit(c, level + 1);
     for (size_t i = cursor; i < cells.size(); ++i) visit(cells[i], level);
+    for (size_t i = 0; i < singles.size(); ++i)
+      visit(singles[i], i >= singleCursor && i < singleLevelEnd ? level : level + 1);
+    for (const Cell& c : newSingles) visit(c, level + 1);
   }
 
-  Status process() {
-    size_t offset = 0;
+  // Applies the header and every whole chunk at the start of `data`; returns
+  // in `offset` how many bytes that used.
+  Status process(const uint8_t* data, size_t size, size_t& offset) {
+    offset = 0;
     Status status;
     while (status.ok()) {
-      const size_t available = pending.size() - offset;
-      const uint8_t* at = pending.data() + offset;
+      const size_t available = size - offset;
+      const uint8_t* at = data + offset;
       if (!hasHeader) {
         if (available < kHeaderBytes) break;
         status = readHeader(at, options.limits, header);
@@ -167,7 +215,6 @@ struct Decoder::State {
         status = Status::error(ErrorCode::CorruptChunk,
                                "the last chunk ends before the kd-tree is complete");
     }
-    pending.erase(pending.begin(), pending.begin() + std::ptrdiff_t(offset));
     return status;
   }
 };
@@ -183,8 +230,17 @@ Status Decoder::push(const uint8_t* data, size_t size) {
   State& s = *state_;
   if (!s.error.ok()) return s.error;
   s.bytesReceived += size;
-  s.pending.insert(s.pending.end(), data, data + size);
-  Status status = s.process();
+  size_t used = 0;
+  Status status;
+  if (s.pending.empty()) {
+    // The usual case of whole chunks in one piece: decode in place, keep the tail.
+    status = s.process(data, size, used);
+    if (status.ok()) s.pending.assign(data + used, data + size);
+  } else {
+    s.pending.insert(s.pending.end(), data, data + size);
+    status = s.process(s.pending.data(), s.pending.size(), used);
+    s.pending.erase(s.pending.begin(), s.pending.begin() + std::ptrdiff_t(used));
+  }
   return status.ok() ? status : s.fail(status);
 }
 
@@ -216,7 +272,8 @@ DecodeProgress Decoder::progress() const {
   p.complete = s.complete();
   if (s.hasHeader)
     p.cellCount = uint32_t(p.complete ? s.header.vertexCount
-                                      : s.children.size() + s.cells.size() - s.cursor);
+                                      : s.children.size() + s.cells.size() - s.cursor + s.singles.size() +
+                                                  s.newSingles.size());
   return p;
 }
 

@@ -7,6 +7,7 @@
 #include "container.h"
 #include "count_coder.h"
 #include "crc32.h"
+#include "kd_order.h"
 #include "kdmesh/kdmesh.h"
 #include "quantizer.h"
 #include "range_coder.h"
@@ -14,8 +15,6 @@
 
 namespace kdmesh {
 namespace {
-
-__extension__ typedef unsigned __int128 KdKey;
 
 constexpr size_t kFirstChunkBytes = 1024;
 constexpr size_t kMinChunkBytes = 64;
@@ -40,23 +39,6 @@ Status checkOptions(const Complex& complex, const EncodeOptions& options) {
                          "connectivity coding is not implemented yet: this version "
                          "encodes vertices only (drop the edges, triangles and tetrahedra)");
   return Status::success();
-}
-
-// Keys whose bits, from the most significant, are the kd-tree's decisions:
-// sorting them puts every kd-tree cell's vertices in one contiguous range.
-std::vector<KdKey> sortedKeys(const std::vector<uint32_t>& coords, const SplitSchedule& schedule) {
-  const size_t n = coords.size() / 3;
-  std::vector<KdKey> keys(n);
-  for (size_t i = 0; i < n; ++i) {
-    KdKey key = 0;
-    for (int level = 0; level < schedule.levels; ++level) {
-      const uint32_t bit = coords[3 * i + schedule.axis[size_t(level)]] >> schedule.splitBit(level);
-      key = (key << 1) | (bit & 1);
-    }
-    keys[i] = key;
-  }
-  std::sort(keys.begin(), keys.end());
-  return keys;
 }
 
 // Writes chunks into the stream body: a frame, then the payload that the
@@ -136,20 +118,32 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options) {
     return result;
   const SplitSchedule schedule(header);
   report("sort", 0);
-  const std::vector<KdKey> keys = sortedKeys(coords, schedule);
+  const std::vector<KdKey> keys = kdOrder(coords, schedule).keys;
   coords = {};
 
   std::vector<uint8_t> body;
   ChunkWriter chunks(body, options.chunkBytes);
   CountCoder counts(schedule.levels);
+  // The decoder's order: per level, first the cells of several vertices,
+  // then the one-vertex cells, each group in kd-tree order.
   struct Cell {
-    uint32_t begin, end;
+    uint32_t begin, end;  // range of `keys`
     bool parentOneSided;
   };
-  std::vector<Cell> cells{{0, header.vertexCount, false}}, children;
+  struct Single {
+    uint32_t key;  // index into `keys`
+    bool parentOneSided;
+  };
+  std::vector<Cell> cells, children;
+  std::vector<Single> singles;
+  if (header.vertexCount == 1)
+    singles.push_back({0, false});
+  else
+    cells.push_back({0, header.vertexCount, false});
   for (int level = 0; level < schedule.levels; ++level) {
     report("code", double(level) / schedule.levels);
     const int bit = schedule.levels - 1 - level;
+    const size_t singleLevelEnd = singles.size();
     children.clear();
     for (const Cell& cell : cells) {
       const uint32_t split = uint32_t(
@@ -159,10 +153,24 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options) {
       const uint32_t population = cell.end - cell.begin, firstHalf = split - cell.begin;
       counts.code(chunks.coder(), population, level, cell.parentOneSided, firstHalf);
       const bool oneSided = firstHalf == 0 || firstHalf == population;
-      if (split > cell.begin) children.push_back({cell.begin, split, oneSided});
-      if (split < cell.end) children.push_back({split, cell.end, oneSided});
+      for (const Cell half : {Cell{cell.begin, split, oneSided}, Cell{split, cell.end, oneSided}}) {
+        if (half.end - half.begin == 1)
+          singles.push_back({half.begin, oneSided});
+        else if (half.end > half.begin)
+          children.push_back(half);
+      }
       chunks.splitDone();
     }
+    for (size_t i = 0; i < singleLevelEnd; ++i) {
+      Single& single = singles[i];
+      const bool inFirstHalf = ((keys[single.key] >> bit) & 1) == 0;
+      counts.codeSingle(chunks.coder(), level, single.parentOneSided, inFirstHalf);
+      single.parentOneSided = true;
+      chunks.splitDone();
+    }
+    std::inplace_merge(singles.begin(), singles.begin() + std::ptrdiff_t(singleLevelEnd),
+                       singles.end(),
+                       [](const Single& a, const Single& b) { return a.key < b.key; });
     std::swap(cells, children);
   }
   header.chunkCount = chunks.finish();
