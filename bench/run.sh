@@ -1,0 +1,57 @@
+#!/bin/sh
+# Benchmark suite: kdmesh against Google Draco on the same models, same
+# machine, same run. Prints Markdown tables (docs/BENCHMARKS.md is made of
+# them).
+#
+#   sh bench/run.sh [--quick]     (npm run bench [-- --quick])
+#
+# --quick runs one model at one quantization with 3 timed runs (CI smoke).
+set -eu
+cd "$(dirname "$0")/.."
+
+runs=7
+quick=0
+for arg in "$@"; do
+  case "$arg" in
+    --quick) quick=1; runs=3 ;;
+    *) echo "bench/run.sh: unknown option $arg" >&2; exit 2 ;;
+  esac
+done
+
+sh scripts/setup.sh
+cmake -S . -B build-bench -DCMAKE_BUILD_TYPE=Release -DKDMESH_BUILD_BENCH=ON \
+  -DKDMESH_BUILD_TESTS=OFF >/dev/null
+cmake --build build-bench -j"$(nproc)" >/dev/null
+
+dragon=$(sh scripts/models.sh)
+models="$dragon"
+if [ -f ../shared/models/bunny.obj ]; then models="../shared/models/bunny.obj $models"; fi
+bits="--bits 12 --bits 16"
+if [ "$quick" = 1 ]; then
+  models=${models%% *}
+  bits="--bits 12"
+fi
+
+echo "## Point clouds: kdmesh vs Draco, in process (warm medians of $runs runs)"
+echo
+# shellcheck disable=SC2086
+./build-bench/kdmesh_bench_points --runs "$runs" $bits $models
+echo
+
+echo "## Point clouds: file sizes from the command-line tools"
+echo
+echo "| model | bits | kdmesh bytes | kdmesh bpv | draco_encoder -point_cloud -cl 10 bytes | Draco bpv |"
+echo "|---|---:|---:|---:|---:|---:|"
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+for model in $models; do
+  for b in $(echo "$bits" | sed 's/--bits//g'); do
+    ./build-bench/kdmesh encode "$model" -o "$tmp/m.kdm" --bits "$b" --points-only -q
+    draco_encoder -point_cloud -i "$model" -o "$tmp/m.drc" -qp "$b" -cl 10 >/dev/null
+    vertices=$(./build-bench/kdmesh info "$tmp/m.kdm" --json | sed -n 's/.*"vertexCount": *\([0-9]*\).*/\1/p' | head -n 1)
+    ours=$(wc -c < "$tmp/m.kdm")
+    theirs=$(wc -c < "$tmp/m.drc")
+    awk -v m="$(basename "$model")" -v b="$b" -v o="$ours" -v t="$theirs" -v n="$vertices" \
+      'BEGIN { printf "| %s | %s | %d | %.3f | %d | %.3f |\n", m, b, o, 8 * o / n, t, 8 * t / n }' 
+  done
+done

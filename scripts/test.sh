@@ -1,0 +1,6 @@
+#!/bin/sh
+# Everything CI checks: build once, then run every test suite.
+set -eu
+cd "$(dirname "$0")/.."
+sh scripts/build.sh
+ctest --test-dir build --output-on-failure -j"$(nproc)"
