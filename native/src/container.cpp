@@ -88,11 +88,20 @@ Status validate(const Header& h, const DecoderLimits& limits) {
                          "stream has " + std::to_string(h.vertexCount) +
                              " vertices, more than the decoder limit of " +
                              std::to_string(limits.maxVertices));
-  if (h.maxDimension != 0 || h.simplexCounts[1] || h.simplexCounts[2] || h.simplexCounts[3])
-    return Status::error(ErrorCode::Unsupported,
-                         "stream has simplices of dimension > 0, which this decoder "
-                         "version cannot decode");
+  if (h.maxDimension > 3) return corrupt("simplex dimension above 3");
+  for (size_t d = size_t(h.maxDimension) + 1; d <= 3; ++d)
+    if (h.simplexCounts[d] != 0) return corrupt("simplices above the maximum dimension");
+  if (h.maxDimension > 0 && h.simplexCounts[h.maxDimension] == 0)
+    return corrupt("no simplex of the maximum dimension");
   if (h.simplexCounts[0] > h.vertexCount) return corrupt("more isolated points than vertices");
+  if (h.maxDimension == 0 && h.simplexCounts[0] != h.vertexCount)
+    return corrupt("a point cloud must count every vertex as a point");
+  const uint64_t simplices = uint64_t(h.simplexCounts[1]) + h.simplexCounts[2] + h.simplexCounts[3];
+  if (simplices > limits.maxSimplices)
+    return Status::error(ErrorCode::LimitExceeded,
+                         "stream has " + std::to_string(simplices) +
+                             " simplices, more than the decoder limit of " +
+                             std::to_string(limits.maxSimplices));
   if (h.bodyBytes < uint64_t(h.chunkCount) * kChunkFrameBytes ||
       (h.chunkCount == 0) != (h.bodyBytes == 0))
     return corrupt("chunk count does not fit the body size");
@@ -152,6 +161,12 @@ Status readHeader(const uint8_t* in, const DecoderLimits& limits, Header& h) {
   h.bodyBytes = get64(in + kOffBodyBytes);
   h.chunkCount = get32(in + kOffChunkCount);
   return validate(h, limits);
+}
+
+std::array<uint64_t, 4> simplexCaps(const Header& h) {
+  const uint64_t edges = h.simplexCounts[1], triangles = h.simplexCounts[2],
+                 tetrahedra = h.simplexCounts[3];
+  return {0, edges + 3 * triangles + 6 * tetrahedra, triangles + 4 * tetrahedra, tetrahedra};
 }
 
 void writeChunkFrame(const ChunkFrame& frame, uint8_t* out) {

@@ -12,7 +12,9 @@
 #include "kdmesh/kdmesh.h"
 #include "quantizer.h"
 #include "range_coder.h"
+#include "simplex_store.h"
 #include "split_schedule.h"
+#include "vertex_split.h"
 
 namespace kdmesh {
 namespace {
@@ -26,6 +28,7 @@ struct Cell {
   // How many one-vertex cells precede this cell in kd-tree order; for a new
   // one-vertex cell, where it goes among those of the previous level.
   uint32_t singlesBefore;
+  uint32_t vertex;  // id in the complex (connectivity streams only)
 };
 
 }  // namespace
@@ -58,9 +61,19 @@ struct Decoder::State {
   size_t cursor = 0, singleCursor = 0, singleLevelEnd = 0;
   int level = 0;
 
+  // Connectivity: the complex on the current cells. Levels past the last
+  // geometric one split cells of coincident vertices in halves.
+  bool connectivity = false;
+  SimplexStore store;
+  std::optional<VertexSplitter> splitter;
+  uint32_t nextVertex = 1;
+  std::vector<uint32_t> parents{0};  // the vertex each vertex was split from
+
   explicit State(const DecoderOptions& o) : options(o) {}
 
-  bool complete() const { return hasHeader && level == schedule->levels; }
+  bool complete() const {
+    return hasHeader && level >= schedule->levels && (!connectivity || cells.empty());
+  }
 
   Status fail(Status status) {
     error = status;
@@ -72,9 +85,16 @@ struct Decoder::State {
     dequantizer.emplace(header);
     counts.emplace(schedule->levels);
     coder.setMeasuring(options.measureCost);
-    const Cell root{{0, 0, 0}, header.vertexCount, 0, 0};
+    const Cell root{{0, 0, 0}, header.vertexCount, 0, 0, 0};
     (header.vertexCount == 1 ? singles : cells).push_back(root);
     singleLevelEnd = singles.size();
+    connectivity = header.maxDimension > 0;
+    if (connectivity) {
+      store.reset(header.vertexCount);
+      const std::array<uint64_t, 4> caps = simplexCaps(header);
+      for (int d = 1; d <= 3; ++d) store.setCapacity(d, uint32_t(std::min<uint64_t>(caps[size_t(d)], 0xffffffffu)));
+      splitter.emplace(store);
+    }
     hasHeader = true;
     return Status::success();
   }
@@ -89,7 +109,8 @@ struct Decoder::State {
         return Status::error(ErrorCode::CorruptChunk,
                              where + ": more splits than the kd-tree has cells");
       if (cursor < cells.size()) {
-        splitCell(cells[cursor++]);
+        if (!splitCell(cells[cursor++]))
+          return Status::error(ErrorCode::CorruptChunk, where + ": inconsistent connectivity codes");
         --left;
       } else {
         const size_t count = std::min<size_t>(left, singleLevelEnd - singleCursor);
@@ -101,18 +122,47 @@ struct Decoder::State {
     }
     if (coder.invalid())
       return Status::error(ErrorCode::CorruptChunk, where + ": undecodable data");
-    cost.geometryBits = coder.cost();
+    cost.geometryBits = coder.cost() - cost.connectivityBits;
+    if (complete() && connectivity) return checkFinalCounts();
     return Status::success();
   }
 
-  void splitCell(const Cell& cell) {
+  // The complete complex must have the maximal simplices the header
+  // announced: a last line of defence against corrupt streams with valid
+  // checksums.
+  Status checkFinalCounts() {
+    Complex complex;
+    appendSimplices(complex);
+    for (int d = 0; d <= 3; ++d)
+      if (complex.simplexCount(d) != header.simplexCounts[size_t(d)])
+        return Status::error(ErrorCode::CorruptChunk,
+                             "the decoded complex has " + std::to_string(complex.simplexCount(d)) +
+                                 " maximal simplices of dimension " + std::to_string(d) +
+                                 ", the header announced " +
+                                 std::to_string(header.simplexCounts[size_t(d)]));
+    return Status::success();
+  }
+
+  // Returns false on connectivity codes that contradict each other.
+  bool splitCell(const Cell& cell) {
     const uint32_t population = cell.population;
-    const uint32_t firstHalf = counts->code(coder, population, level, cell.parentOneSided, 0);
+    const bool geometric = level < schedule->levels;
+    const uint32_t firstHalf = geometric
+                                   ? counts->code(coder, population, level, cell.parentOneSided, 0)
+                                   : population / 2;
     const bool oneSided = firstHalf == 0 || firstHalf == population;
-    const int axis = schedule->axis[size_t(level)];
     Cell child = cell;
     child.parentOneSided = oneSided;
-    child.prefix[axis] = cell.prefix[axis] << 1;
+    const int axis = geometric ? schedule->axis[size_t(level)] : 0;
+    if (geometric) child.prefix[axis] = cell.prefix[axis] << 1;
+    uint32_t added = cell.vertex;
+    if (connectivity && !oneSided) {
+      added = nextVertex++;
+      parents.push_back(cell.vertex);
+      const double before = coder.cost();
+      if (!splitter->split(coder, cell.vertex, added, [] { return uint8_t(0); })) return false;
+      cost.connectivityBits += coder.cost() - before;
+    }
     for (const uint32_t half : {firstHalf, population - firstHalf}) {
       if (half == 1) {
         child.population = 1;
@@ -123,8 +173,10 @@ struct Decoder::State {
         child.singlesBefore = cell.singlesBefore + uint32_t(newSingles.size());
         children.push_back(child);
       }
-      child.prefix[axis] |= 1;
+      if (geometric) child.prefix[axis] |= 1;
+      child.vertex = added;
     }
+    return true;
   }
 
   void refineSingles(size_t begin, size_t end) {
@@ -150,14 +202,51 @@ struct Decoder::State {
     std::swap(cells, children);
     children.clear();
     cursor = 0;
-    singleCursor = 0;
-    singleLevelEnd = singles.size();
     ++level;
+    // Past the geometric levels one-vertex cells are final.
+    singleCursor = level < schedule->levels ? 0 : singles.size();
+    singleLevelEnd = singles.size();
+  }
+
+  // Appends the maximal simplices of the current complex, oriented, and its
+  // isolated vertices.
+  void appendSimplices(Complex& out) const {
+    auto append = [&](int d, uint32_t simplex, std::vector<uint32_t>& list) {
+      const uint32_t* v = store.vertices(d, simplex);
+      const size_t at = list.size();
+      list.insert(list.end(), v, v + d + 1);
+      if (store.flags(d, simplex) & SimplexStore::kFlipped) std::swap(list[at], list[at + 1]);
+    };
+    std::vector<uint8_t> covered;
+    std::vector<uint32_t>* lists[4] = {nullptr, &out.edges, &out.triangles, &out.tetrahedra};
+    std::vector<uint8_t> coveredBelow;
+    for (int d = 3; d >= 1; --d) {
+      // Faces of live simplices of dimension d + 1 are not maximal.
+      coveredBelow.assign(d > 1 ? store.size(d - 1) : 0, 0);
+      for (uint32_t simplex = 0; simplex < store.size(d); ++simplex) {
+        if (!(store.flags(d, simplex) & SimplexStore::kAlive)) continue;
+        if (covered.empty() || !covered[simplex]) append(d, simplex, *lists[d]);
+        if (d == 1) continue;
+        const uint32_t* v = store.vertices(d, simplex);
+        for (int skip = 0; skip <= d; ++skip) {
+          uint32_t face[3];
+          int n = 0;
+          for (int i = 0; i <= d; ++i)
+            if (i != skip) face[n++] = v[i];
+          const uint32_t f = store.find(d - 1, face);
+          if (f != kNoSimplex) coveredBelow[f] = 1;
+        }
+      }
+      covered.swap(coveredBelow);
+    }
+    for (uint32_t v = 0; v < nextVertex; ++v)
+      if (!store.hasIncident(1, v)) out.points.push_back(v);
   }
 
   // Integer coordinate range [lo, hi] along `axis` of a cell at `cellLevel`,
   // clamped to the coded bounding box.
   void cellRange(const Cell& cell, int cellLevel, int axis, uint32_t& lo, uint32_t& hi) const {
+    cellLevel = std::min(cellLevel, schedule->levels);
     const int free = schedule->bits[size_t(axis)] - schedule->consumed[size_t(cellLevel)][size_t(axis)];
     const uint64_t low = uint64_t(cell.prefix[axis]) << free;
     const uint64_t high = low + ((uint64_t(1) << free) - 1);
@@ -260,6 +349,10 @@ const Header& Decoder::header() const { return state_->header; }
 bool Decoder::complete() const { return state_->complete(); }
 const std::vector<ChunkInfo>& Decoder::chunks() const { return state_->chunks; }
 CodingCost Decoder::cost() const { return state_->cost; }
+const std::vector<uint32_t>& Decoder::vertexParents() const { return state_->parents; }
+ConnectivityStatistics Decoder::statistics() const {
+  return state_->splitter ? state_->splitter->statistics() : ConnectivityStatistics{};
+}
 
 DecodeProgress Decoder::progress() const {
   const State& s = *state_;
@@ -281,6 +374,18 @@ void Decoder::snapshot(Complex& out) const {
   const State& s = *state_;
   out = Complex{};
   if (!s.hasHeader) return;
+  if (s.connectivity) {
+    out.positions.resize(size_t(s.nextVertex) * 3);
+    s.forEachCurrentCell([&](const Cell& cell, int cellLevel) {
+      for (int a = 0; a < 3; ++a) {
+        uint32_t lo, hi;
+        s.cellRange(cell, cellLevel, a, lo, hi);
+        out.positions[size_t(cell.vertex) * 3 + size_t(a)] = s.dequantizer->position(a, lo, hi);
+      }
+    });
+    s.appendSimplices(out);
+    return;
+  }
   const bool complete = s.complete();
   out.positions.reserve(size_t(complete ? s.header.vertexCount : progress().cellCount) * 3);
   s.forEachCurrentCell([&](const Cell& cell, int cellLevel) {

@@ -7,11 +7,14 @@
 #include "container.h"
 #include "count_coder.h"
 #include "crc32.h"
+#include "decimation.h"
 #include "kd_order.h"
 #include "kdmesh/kdmesh.h"
 #include "quantizer.h"
 #include "range_coder.h"
+#include "simplex_store.h"
 #include "split_schedule.h"
+#include "vertex_split.h"
 
 namespace kdmesh {
 namespace {
@@ -34,10 +37,6 @@ Status checkOptions(const Complex& complex, const EncodeOptions& options) {
     return Status::error(ErrorCode::InvalidInput, "the input has no vertices");
   if (complex.vertexCount() >= (size_t(1) << 31))
     return Status::error(ErrorCode::InvalidInput, "more than 2^31 - 1 vertices");
-  if (complex.hasSimplices())
-    return Status::error(ErrorCode::Unsupported,
-                         "connectivity coding is not implemented yet: this version "
-                         "encodes vertices only (drop the edges, triangles and tetrahedra)");
   return Status::success();
 }
 
@@ -99,6 +98,87 @@ class ChunkWriter {
   uint32_t chunks_ = 0;
 };
 
+// Visits the kd-tree splits in the decoder's order (docs/FORMAT.md) and names
+// the vertices as the decoder will: the root is vertex 0, and a cell that
+// splits into two non-empty halves gives its id to the first half and the
+// next unused id to the second. With `coincidentLevels`, cells that still
+// hold several vertices after the last level go on splitting in halves, so
+// that coincident vertices get their own ids.
+//
+// The visitor sees cell(level, geometric, population, firstHalf,
+// parentOneSided, keptId, addedId) for cells of several vertices (addedId is
+// kNoSimplex for a one-sided split), single(level, parentOneSided,
+// inFirstHalf) for one-vertex cells, named(keyIndex, id) when a vertex gets
+// its final id, and splitDone() after each split.
+template <class Visitor>
+void traverseKdTree(const std::vector<KdKey>& keys, const SplitSchedule& schedule,
+                    bool coincidentLevels, Visitor&& visitor) {
+  struct Cell {
+    uint32_t begin, end, id;
+    bool parentOneSided;
+  };
+  struct Single {
+    uint32_t key, id;
+    bool parentOneSided;
+  };
+  const uint32_t n = uint32_t(keys.size());
+  std::vector<Cell> cells, children;
+  std::vector<Single> singles;
+  uint32_t nextId = 1;
+  if (n == 1) {
+    singles.push_back({0, 0, false});
+    visitor.named(0, 0);
+  } else {
+    cells.push_back({0, n, 0, false});
+  }
+  for (int level = 0;; ++level) {
+    const bool geometric = level < schedule.levels;
+    if (!geometric && (!coincidentLevels || cells.empty())) break;
+    const int bit = schedule.levels - 1 - level;
+    const size_t oldSingles = singles.size();
+    const size_t singleLevelEnd = geometric ? oldSingles : 0;
+    children.clear();
+    for (const Cell& cell : cells) {
+      const uint32_t population = cell.end - cell.begin;
+      const uint32_t split =
+          geometric ? uint32_t(std::partition_point(keys.begin() + cell.begin, keys.begin() + cell.end,
+                                                    [bit](KdKey k) { return ((k >> bit) & 1) == 0; }) -
+                               keys.begin())
+                    : cell.begin + population / 2;
+      const uint32_t firstHalf = split - cell.begin;
+      const bool oneSided = firstHalf == 0 || firstHalf == population;
+      const uint32_t addedId = oneSided ? kNoSimplex : nextId++;
+      visitor.cell(level, geometric, population, firstHalf, cell.parentOneSided, cell.id, addedId);
+      const Cell halves[2] = {{cell.begin, split, cell.id, oneSided},
+                              {split, cell.end, oneSided ? cell.id : addedId, oneSided}};
+      for (const Cell& half : halves) {
+        if (half.end - half.begin == 1) {
+          singles.push_back({half.begin, half.id, oneSided});
+          visitor.named(half.begin, half.id);
+        } else if (half.end > half.begin) {
+          children.push_back(half);
+        }
+      }
+      visitor.splitDone();
+    }
+    for (size_t i = 0; i < singleLevelEnd; ++i) {
+      Single& single = singles[i];
+      visitor.single(level, single.parentOneSided, ((keys[single.key] >> bit) & 1) == 0);
+      single.parentOneSided = true;
+      visitor.splitDone();
+    }
+    std::inplace_merge(singles.begin(), singles.begin() + std::ptrdiff_t(oldSingles),
+                       singles.end(), [](const Single& a, const Single& b) { return a.key < b.key; });
+    std::swap(cells, children);
+  }
+}
+
+// Supplies the decimation's record bytes of one split, in order.
+struct RecordReader {
+  const uint8_t* next;
+  uint8_t operator()() { return *next++; }
+};
+
 }  // namespace
 
 EncodeResult encode(const Complex& complex, const EncodeOptions& options) {
@@ -111,71 +191,100 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options) {
   Header header;
   header.version = kFormatVersion;
   header.vertexCount = uint32_t(complex.vertexCount());
-  header.simplexCounts[0] = header.vertexCount;
   std::vector<uint32_t> coords;
   report("quantize", 0);
   if (result.status = quantize(complex.positions, options, header, coords); !result.status.ok())
     return result;
   const SplitSchedule schedule(header);
   report("sort", 0);
-  const std::vector<KdKey> keys = kdOrder(coords, schedule).keys;
+  KdOrder order = kdOrder(coords, schedule);
   coords = {};
 
+  // Connectivity, fine to coarse: name the vertices as the decoder will,
+  // build the input complex on those names, and merge cells in the reverse
+  // of the split order.
+  SplitRecords records;
+  bool connectivity = complex.hasSimplices();
+  if (connectivity) {
+    report("connectivity", 0);
+    std::vector<uint32_t> ids(header.vertexCount);
+    std::vector<VertexSplitIds> splits;
+    struct Naming {
+      std::vector<uint32_t>& ids;
+      std::vector<VertexSplitIds>& splits;
+      const std::vector<uint32_t>& vertexOfKey;
+      void cell(int, bool, uint32_t, uint32_t, bool, uint32_t kept, uint32_t added) {
+        if (added != kNoSimplex) splits.push_back({kept, added});
+      }
+      void single(int, bool, bool) {}
+      void named(uint32_t key, uint32_t id) { ids[vertexOfKey[key]] = id; }
+      void splitDone() {}
+    } naming{ids, splits, order.vertices};
+    traverseKdTree(order.keys, schedule, true, naming);
+    SimplexStore store;
+    InputSummary summary;
+    if (result.status = buildInputComplex(complex, ids, store, summary); !result.status.ok())
+      return result;
+    result.repairs = summary.repairs;
+    connectivity = summary.maxDimension > 0;
+    header.maxDimension = uint8_t(summary.maxDimension);
+    for (size_t d = 0; d < 4; ++d) header.simplexCounts[d] = summary.maximal[d];
+    if (connectivity)
+      decimate(store, splits, records, [&](double f) { report("connectivity", f); });
+  }
+  if (!connectivity) header.simplexCounts[0] = header.vertexCount;
+
+  // Coarse to fine: the counts and, after each vertex split, its codes.
   std::vector<uint8_t> body;
   ChunkWriter chunks(body, options.chunkBytes);
+  RangeEncoder& coder = chunks.coder();
   CountCoder counts(schedule.levels);
-  // The decoder's order: per level, first the cells of several vertices,
-  // then the one-vertex cells, each group in kd-tree order.
-  struct Cell {
-    uint32_t begin, end;  // range of `keys`
-    bool parentOneSided;
-  };
-  struct Single {
-    uint32_t key;  // index into `keys`
-    bool parentOneSided;
-  };
-  std::vector<Cell> cells, children;
-  std::vector<Single> singles;
-  if (header.vertexCount == 1)
-    singles.push_back({0, false});
-  else
-    cells.push_back({0, header.vertexCount, false});
-  for (int level = 0; level < schedule.levels; ++level) {
-    report("code", double(level) / schedule.levels);
-    const int bit = schedule.levels - 1 - level;
-    const size_t singleLevelEnd = singles.size();
-    children.clear();
-    for (const Cell& cell : cells) {
-      const uint32_t split = uint32_t(
-          std::partition_point(keys.begin() + cell.begin, keys.begin() + cell.end,
-                               [bit](KdKey k) { return ((k >> bit) & 1) == 0; }) -
-          keys.begin());
-      const uint32_t population = cell.end - cell.begin, firstHalf = split - cell.begin;
-      counts.code(chunks.coder(), population, level, cell.parentOneSided, firstHalf);
-      const bool oneSided = firstHalf == 0 || firstHalf == population;
-      for (const Cell half : {Cell{cell.begin, split, oneSided}, Cell{split, cell.end, oneSided}}) {
-        if (half.end - half.begin == 1)
-          singles.push_back({half.begin, oneSided});
-        else if (half.end > half.begin)
-          children.push_back(half);
+  SimplexStore forward;
+  forward.reset(header.vertexCount);
+  VertexSplitter splitter(forward);
+  size_t splitIndex = 0;
+  double connectivityBits = 0;
+  struct Coding {
+    const Header& header;
+    const SplitSchedule& schedule;
+    CountCoder& counts;
+    RangeEncoder& coder;
+    ChunkWriter& chunks;
+    VertexSplitter& splitter;
+    const SplitRecords& records;
+    size_t& splitIndex;
+    double& connectivityBits;
+    bool connectivity;
+    std::function<void(const char*, double)> report;
+    int reportedLevel = -1;
+
+    void cell(int level, bool geometric, uint32_t population, uint32_t firstHalf,
+              bool parentOneSided, uint32_t kept, uint32_t added) {
+      if (level != reportedLevel) {
+        reportedLevel = level;
+        report("code", double(level) / double(schedule.levels + 1));
       }
-      chunks.splitDone();
+      if (geometric) counts.code(coder, population, level, parentOneSided, firstHalf);
+      if (connectivity && added != kNoSimplex) {
+        const double before = coder.cost();
+        splitter.split(coder, kept, added, RecordReader{&records.bytes[records.begin[splitIndex]]});
+        ++splitIndex;
+        connectivityBits += coder.cost() - before;
+      }
     }
-    for (size_t i = 0; i < singleLevelEnd; ++i) {
-      Single& single = singles[i];
-      const bool inFirstHalf = ((keys[single.key] >> bit) & 1) == 0;
-      counts.codeSingle(chunks.coder(), level, single.parentOneSided, inFirstHalf);
-      single.parentOneSided = true;
-      chunks.splitDone();
+    void single(int level, bool parentOneSided, bool inFirstHalf) {
+      counts.codeSingle(coder, level, parentOneSided, inFirstHalf);
     }
-    std::inplace_merge(singles.begin(), singles.begin() + std::ptrdiff_t(singleLevelEnd),
-                       singles.end(),
-                       [](const Single& a, const Single& b) { return a.key < b.key; });
-    std::swap(cells, children);
-  }
+    void named(uint32_t, uint32_t) {}
+    void splitDone() { chunks.splitDone(); }
+  } coding{header, schedule, counts, coder, chunks, splitter, records, splitIndex,
+           connectivityBits, connectivity, report};
+  traverseKdTree(order.keys, schedule, connectivity, coding);
   header.chunkCount = chunks.finish();
   header.bodyBytes = body.size();
-  result.cost.geometryBits = chunks.coder().cost();
+  result.cost.connectivityBits = connectivityBits;
+  result.cost.geometryBits = coder.cost() - connectivityBits;
+  result.statistics = splitter.statistics();
   report("code", 1);
 
   result.bytes.resize(kHeaderBytes + body.size());

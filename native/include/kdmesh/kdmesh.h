@@ -148,10 +148,33 @@ struct CodingCost {
   double connectivityBits = 0;
 };
 
+// Input simplices the encoder dropped, per dimension. A complex holds a
+// simplex once, so a simplex listed twice (in any vertex order), or listed
+// although it is a face of another listed simplex, is redundant; a simplex
+// with a repeated vertex is degenerate. Points ([0]) are redundant when the
+// vertex belongs to an edge, triangle or tetrahedron.
+struct InputRepairs {
+  std::array<uint64_t, 4> degenerate{};
+  std::array<uint64_t, 4> duplicate{};
+  std::array<uint64_t, 4> redundant{};
+};
+
+// What the connectivity coder did (the same on both sides of a stream).
+struct ConnectivityStatistics {
+  uint64_t vertexSplits = 0;
+  // Codes given to star simplices, [dimension][code - 1] (codes 1..4, see
+  // docs/FORMAT.md); dimension 0 is the split vertex itself.
+  std::array<std::array<uint64_t, 4>, 4> codes{};
+  uint64_t orientationBits = 0;          // orientation decisions coded
+  uint64_t orientationMispredicted = 0;  // of which the prediction was wrong
+};
+
 struct EncodeResult {
   Status status;
   std::vector<uint8_t> bytes;
   CodingCost cost;
+  InputRepairs repairs;
+  ConnectivityStatistics statistics;
 };
 
 EncodeResult encode(const Complex& complex, const EncodeOptions& options = {});
@@ -165,6 +188,8 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options = {});
 struct DecoderLimits {
   uint32_t maxVertices = 1u << 27;
   uint32_t maxChunkBytes = 1u << 26;
+  // Edges, triangles and tetrahedra of the complete complex, together.
+  uint32_t maxSimplices = 1u << 28;
 };
 
 struct DecoderOptions {
@@ -220,10 +245,21 @@ class Decoder {
   DecodeProgress progress() const;
   const std::vector<ChunkInfo>& chunks() const;  // applied so far
   CodingCost cost() const;  // filled when DecoderOptions::measureCost
+  ConnectivityStatistics statistics() const;
+  // For connectivity streams, vertex ids are stable from prefix to prefix:
+  // when a vertex splits, its first half keeps its id and the second half
+  // gets the next one. vertexParents()[v] is the vertex that v was split
+  // from (0 for vertex 0), so a viewer can animate refinement and any final
+  // vertex can be traced to its ancestor at a coarser level.
+  const std::vector<uint32_t>& vertexParents() const;
 
   // The model at the current level: one vertex at the centre of every
   // current kd-tree cell (clamped to the bounding box), or, once complete,
   // every input vertex at its exact (quantized) position. Replaces `out`.
+  // With connectivity, vertex v of the snapshot is vertex id v, and the
+  // simplices are the maximal simplices of the current complex (the input
+  // complex with every vertex replaced by its cell), oriented as the input
+  // simplices they stand for.
   void snapshot(Complex& out) const;
   Complex snapshot() const;
   // Half the diagonal of the largest current cell: no input vertex is

@@ -147,6 +147,18 @@ Status readOff(const uint8_t* data, size_t size, Complex& out, Notes& notes) {
     split.append(polygon.data(), polygon.size(), out.triangles);
   }
 
+  // More lines than the header declares: most likely wrong counts, so say so
+  // rather than drop them silently.
+  size_t extraLines = 0, firstExtraLine = 0;
+  while (scanner.nextContentLine()) {
+    if (extraLines++ == 0) firstExtraLine = scanner.lineNumber();
+  }
+  if (extraLines > 0) {
+    notes.push_back("ignored " + std::to_string(extraLines) +
+                    " lines after the " + std::to_string(faceCount) +
+                    " faces that the header declares (the first: line " +
+                    std::to_string(firstExtraLine) + ")");
+  }
   addCountNote(notes,
                "ignored extra vertex columns (colour, normal or texture "
                "coordinates) on ",

@@ -530,6 +530,9 @@ void reserveFor(Role role, uint64_t count, Complex& out) {
 template <class Values>
 Status readElement(Values& values, const PlyElement& element,
                    const ElementPlan& plan, BodyState& state) {
+  // Items without properties take no bytes, so the budget does not bound
+  // their count: do not spend a step on each of up to 2^64 of them.
+  if (element.properties.empty()) return Status::success();
   Complex& out = state.out;
   for (uint64_t item = 0; item < element.count; ++item) {
     float xyz[3] = {0, 0, 0};
@@ -645,9 +648,12 @@ Status readPly(const uint8_t* data, size_t size, Complex& out, Notes& notes) {
   BodyState state{out, vertexCount, {}, {}};
   Status status;
   uint64_t trailingBytes = 0;
+  uint64_t trailingValues = 0;
   if (header.encoding == Encoding::Ascii) {
     AsciiValues values(scanner);
     status = readBody(values, header, plans, state);
+    std::string_view token;
+    while (status.ok() && scanner.nextTokenAcrossLines(token)) ++trailingValues;
   } else {
     BinaryValues values(data, scanner.nextLineOffset(), size,
                         header.encoding == Encoding::BinaryBigEndian);
@@ -658,6 +664,8 @@ Status readPly(const uint8_t* data, size_t size, Complex& out, Notes& notes) {
   state.split.addNote(notes);
   addCountNote(notes, "ignored ", trailingBytes,
                " bytes after the last PLY element");
+  addCountNote(notes, "ignored ", trailingValues,
+               " values after the last PLY element");
   return Status::success();
 }
 

@@ -1,0 +1,185 @@
+#include "decimation.h"
+
+#include <algorithm>
+#include <string>
+
+#include "vertex_split.h"
+
+namespace kdmesh {
+namespace {
+
+const char* const kSimplexName[4] = {"point", "edge", "triangle", "tetrahedron"};
+
+bool hasRepeatedVertex(const uint32_t* v, int arity) {
+  for (int i = 0; i < arity; ++i)
+    for (int j = i + 1; j < arity; ++j)
+      if (v[i] == v[j]) return true;
+  return false;
+}
+
+// Adds the faces of a simplex of dimension d >= 2 that are missing.
+void addMissingFaces(SimplexStore& store, int d, const uint32_t* v) {
+  for (int skip = 0; skip <= d; ++skip) {
+    uint32_t face[3];
+    int n = 0;
+    for (int i = 0; i <= d; ++i)
+      if (i != skip) face[n++] = v[i];
+    if (store.find(d - 1, face) != kNoSimplex) continue;
+    store.add(d - 1, face, 0);
+    if (d - 1 >= 2) addMissingFaces(store, d - 1, face);
+  }
+}
+
+// Scratch bits of a record byte under construction; the final byte holds
+// only code and targets.
+constexpr uint8_t kHasCopy = 0x40, kHasAdded = 0x80;
+
+}  // namespace
+
+Status buildInputComplex(const Complex& complex, const std::vector<uint32_t>& ids,
+                         SimplexStore& store, InputSummary& summary) {
+  const size_t n = complex.vertexCount();
+  summary = InputSummary{};
+  store.reset(uint32_t(n));
+  const std::vector<uint32_t>* lists[4] = {&complex.points, &complex.edges, &complex.triangles,
+                                           &complex.tetrahedra};
+  for (int d = 0; d <= 3; ++d) {
+    const std::vector<uint32_t>& list = *lists[d];
+    if (list.size() % size_t(d + 1) != 0)
+      return Status::error(ErrorCode::InvalidInput,
+                           std::string(kSimplexName[d]) + " indices are not a multiple of " +
+                               std::to_string(d + 1));
+    for (size_t i = 0; i < list.size(); ++i)
+      if (list[i] >= n)
+        return Status::error(ErrorCode::InvalidInput,
+                             std::string(kSimplexName[d]) + " " + std::to_string(i / size_t(d + 1)) +
+                                 " refers to vertex " + std::to_string(list[i]) + ", but there are " +
+                                 std::to_string(n) + " vertices");
+  }
+  // Highest dimension first, so that a listed face of a listed simplex is
+  // recognised whatever the order of the lists.
+  for (int d = 3; d >= 1; --d) {
+    const std::vector<uint32_t>& list = *lists[d];
+    const size_t arity = size_t(d + 1);
+    for (size_t i = 0; i < list.size(); i += arity) {
+      uint32_t v[4];
+      for (size_t j = 0; j < arity; ++j) v[j] = ids[list[i + j]];
+      if (hasRepeatedVertex(v, d + 1)) {
+        ++summary.repairs.degenerate[size_t(d)];
+        continue;
+      }
+      const uint32_t existing = store.find(d, v);
+      if (existing != kNoSimplex) {
+        const bool listed = store.flags(d, existing) & SimplexStore::kMeaningful;
+        ++(listed ? summary.repairs.duplicate : summary.repairs.redundant)[size_t(d)];
+        continue;
+      }
+      store.add(d, v, SimplexStore::kMeaningful);
+      ++summary.maximal[size_t(d)];
+      summary.maxDimension = std::max(summary.maxDimension, d);
+      if (d >= 2) addMissingFaces(store, d, v);
+    }
+  }
+  for (uint32_t point : complex.points)
+    if (store.hasIncident(1, ids[point])) ++summary.repairs.redundant[0];
+  for (uint32_t v = 0; v < n; ++v) summary.maximal[0] += !store.hasIncident(1, v);
+  return Status::success();
+}
+
+void decimate(SimplexStore& store, const std::vector<VertexSplitIds>& splits,
+              SplitRecords& records, const std::function<void(double)>& progress) {
+  std::array<std::vector<uint8_t>, 4> scratch;  // record bytes under construction
+  for (int d = 1; d <= 3; ++d) scratch[size_t(d)].assign(store.size(d), 0);
+  std::vector<uint32_t> star2;
+  std::vector<StarEntry> star;
+  std::array<size_t, 5> begin{};
+  records.bytes.clear();
+  // Merges are recorded last split first; `end` of each split is turned into
+  // the forward `begin` at the end.
+  std::vector<uint64_t> recordEnd(splits.size());
+  std::vector<uint8_t> reversed;
+
+  for (size_t k = splits.size(); k-- > 0;) {
+    if (progress && (k & 0xffff) == 0) progress(1.0 - double(k) / double(splits.size()));
+    const uint32_t v1 = splits[k].kept, v2 = splits[k].added;
+    const uint32_t edge[2] = {v1, v2};
+    const bool joined = store.find(1, edge) != kNoSimplex;
+
+    for (int d = 1; d <= 3; ++d) {
+      star2.clear();
+      store.forEachIncident(d, v2, [&](uint32_t s, uint32_t) { star2.push_back(s); });
+      store.detach(d, v2);
+      for (const uint32_t s : star2) {
+        const uint32_t* sv = store.vertices(d, s);
+        const bool meaningful = store.flags(d, s) & SimplexStore::kMeaningful;
+        const uint8_t target = d >= 2 && meaningful ? split_record::target(store.parity(d, s)) : 0;
+        if (std::find(sv, sv + d + 1, v1) != sv + d + 1) {
+          // S = S' ∪ {v1, v2}: the decoder makes it by coding S' as 4.
+          if (d >= 2) {
+            uint32_t face[3];
+            int n = 0;
+            for (int i = 0; i <= d; ++i)
+              if (sv[i] != v2) face[n++] = sv[i];
+            const uint32_t parent = store.find(d - 1, face);
+            scratch[size_t(d - 1)][parent] |=
+                uint8_t(kHasAdded | (target << split_record::kNewTargetShift));
+          }
+          store.kill(d, s);
+          continue;
+        }
+        uint32_t merged[4];
+        std::copy(sv, sv + d + 1, merged);
+        *std::find(merged, merged + d + 1, v2) = v1;
+        const uint32_t twin = store.find(d, merged);
+        if (twin == kNoSimplex) {
+          // Only v2 has it: code 2.
+          const uint32_t position = uint32_t(std::find(sv, sv + d + 1, v2) - sv);
+          store.replaceVertex(d, s, v2, v1);
+          store.link(d, s, position);
+          scratch[size_t(d)][s] = 1;
+          continue;
+        }
+        // Both have it: code 3 (or 4, marked by the simplex one dimension up).
+        scratch[size_t(d)][twin] |= uint8_t(kHasCopy | (target << split_record::kCopyTargetShift));
+        uint8_t& twinFlags = store.flags(d, twin);
+        if (d >= 2 && meaningful && !(twinFlags & SimplexStore::kMeaningful)) {
+          // The coarse simplex takes the orientation of the one that matters.
+          const int wanted = tupleParity(merged, d + 1) ^ ((store.flags(d, s) & SimplexStore::kFlipped) ? 1 : 0);
+          if (store.parity(d, twin) != wanted) twinFlags ^= SimplexStore::kFlipped;
+          twinFlags |= SimplexStore::kMeaningful;
+        }
+        store.kill(d, s);
+      }
+    }
+
+    gatherStar(store, v1, star, begin);
+    const size_t first = reversed.size();
+    reversed.push_back(joined ? 3 : 2);
+    for (size_t i = 1; i < star.size(); ++i) {
+      uint8_t& bits = scratch[star[i].dimension][star[i].simplex];
+      const uint8_t code = (bits & kHasAdded) ? 3 : (bits & kHasCopy) ? 2 : (bits & split_record::kCodeMask);
+      reversed.push_back(uint8_t(code | (bits & 0x3c)));
+      bits = 0;
+    }
+    recordEnd[k] = reversed.size() - first;  // length for now
+  }
+
+  // Lay the records out in split order.
+  records.begin.resize(splits.size() + 1);
+  records.bytes.resize(reversed.size());
+  uint64_t at = 0;
+  for (size_t k = 0; k < splits.size(); ++k) {
+    records.begin[k] = at;
+    at += recordEnd[k];
+  }
+  records.begin[splits.size()] = at;
+  // `reversed` holds split k's records at offset (total - begin[k+1]).
+  for (size_t k = 0; k < splits.size(); ++k) {
+    const uint64_t length = recordEnd[k];
+    const uint64_t from = at - records.begin[k + 1];
+    std::copy(reversed.begin() + std::ptrdiff_t(from), reversed.begin() + std::ptrdiff_t(from + length),
+              records.bytes.begin() + std::ptrdiff_t(records.begin[k]));
+  }
+}
+
+}  // namespace kdmesh

@@ -1,0 +1,112 @@
+// A simplicial complex that changes one vertex star at a time: the encoder
+// merges vertices (decimation), the decoder splits them.
+//
+// Simplices of dimension 1..3 live in flat per-dimension pools. A simplex
+// stores its vertices as an oriented tuple (for triangles and tetrahedra the
+// tuple order, corrected by a `flipped` bit, is the orientation); a hash
+// index finds a simplex from its vertex set in any order. Each vertex has,
+// per dimension, a singly linked list of the incidence slots (simplex,
+// position in tuple) that hold it, so a star is walked without scanning the
+// complex. Killed simplices leave their slots in the lists of other vertices;
+// walks drop them as they pass.
+#pragma once
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+namespace kdmesh {
+
+constexpr uint32_t kNoSimplex = 0xffffffffu;
+
+// Parity of the permutation that sorts the n vertex ids v[0..n) ascending:
+// 0 even, 1 odd.
+int tupleParity(const uint32_t* v, int n);
+
+class SimplexStore {
+ public:
+  static constexpr int kMaxDimension = 3;
+
+  enum Flag : uint8_t {
+    kAlive = 1,
+    kFlipped = 2,     // orientation is the tuple with its first two swapped
+    kMeaningful = 4,  // encoder: some input simplex of this dimension maps here
+    kUndecided = 8,   // orientation not yet decoded in the current split
+  };
+
+  void reset(uint32_t vertexCapacity);
+  uint32_t vertexCapacity() const { return uint32_t(heads_[1].size()); }
+  // Pool sizes (live and killed) may not exceed these; add() reports false.
+  void setCapacity(int dimension, uint32_t maxSimplices);
+
+  // Adds a simplex whose vertices are all distinct and that is not yet
+  // present; links it into its vertices' lists. Returns its index, or
+  // kNoSimplex when the pool is at capacity.
+  uint32_t add(int dimension, const uint32_t* vertices, uint8_t flags);
+  // Index of the live simplex with this vertex set, or kNoSimplex.
+  uint32_t find(int dimension, const uint32_t* vertices) const;
+  void kill(int dimension, uint32_t simplex);
+  // Replaces vertex `from` of a simplex by `to` (which it must not contain),
+  // keeping the orientation. Lists are left alone: the split and merge
+  // routines detach and relink the two vertices' lists themselves.
+  void replaceVertex(int dimension, uint32_t simplex, uint32_t from, uint32_t to);
+
+  const uint32_t* vertices(int dimension, uint32_t simplex) const {
+    return &pool_[dimension].vertices[size_t(simplex) * size_t(dimension + 1)];
+  }
+  uint8_t& flags(int dimension, uint32_t simplex) { return pool_[dimension].flags[simplex]; }
+  uint8_t flags(int dimension, uint32_t simplex) const { return pool_[dimension].flags[simplex]; }
+  uint32_t size(int dimension) const { return uint32_t(pool_[dimension].flags.size()); }
+  uint32_t liveCount(int dimension) const { return live_[dimension]; }
+
+  // Orientation as the parity of the oriented tuple relative to the
+  // ascending order of its vertex ids (0 even, 1 odd).
+  int parity(int dimension, uint32_t simplex) const;
+
+  // Calls visit(simplex, position) for every live simplex of `dimension`
+  // holding `vertex`, unlinking killed ones on the way.
+  template <class Visit>
+  void forEachIncident(int dimension, uint32_t vertex, Visit&& visit) {
+    Pool& pool = pool_[dimension];
+    const uint32_t arity = uint32_t(dimension + 1);
+    uint32_t* link = &heads_[dimension][vertex];
+    while (*link != kNoSimplex) {
+      const uint32_t slot = *link;
+      const uint32_t simplex = slot / arity;
+      if (!(pool.flags[simplex] & kAlive)) {
+        *link = pool.next[slot];
+        continue;
+      }
+      visit(simplex, slot % arity);
+      link = &pool.next[slot];
+    }
+  }
+  bool hasIncident(int dimension, uint32_t vertex) const;
+
+  // Empties `vertex`'s list of `dimension` without touching the simplices;
+  // the caller relinks every slot it keeps with link().
+  void detach(int dimension, uint32_t vertex) { heads_[dimension][vertex] = kNoSimplex; }
+  void link(int dimension, uint32_t simplex, uint32_t position);
+
+ private:
+  struct Pool {
+    std::vector<uint32_t> vertices;  // dimension + 1 per simplex
+    std::vector<uint32_t> next;      // next slot in the vertex list, per slot
+    std::vector<uint8_t> flags;
+    std::vector<uint32_t> table;     // open addressing, simplex indices
+    uint32_t capacity = 0xffffffffu;
+  };
+
+  static uint64_t hashOf(int dimension, const uint32_t* vertices);
+  bool sameSet(int dimension, uint32_t simplex, const uint32_t* vertices) const;
+  void insertIndex(int dimension, uint32_t simplex);
+  void eraseIndex(int dimension, uint32_t simplex);
+  void grow(int dimension);
+
+  std::array<Pool, 4> pool_;                      // [0] unused
+  std::array<std::vector<uint32_t>, 4> heads_;    // [0] unused
+  std::array<uint32_t, 4> live_{};
+};
+
+}  // namespace kdmesh

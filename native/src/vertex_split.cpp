@@ -1,0 +1,132 @@
+#include "vertex_split.h"
+
+namespace kdmesh {
+namespace {
+
+bool lessOthers(const uint32_t* a, const uint32_t* b, int count) {
+  for (int i = 0; i < count; ++i)
+    if (a[i] != b[i]) return a[i] < b[i];
+  return false;
+}
+
+bool containsVertex(const uint32_t* vertices, int arity, uint32_t vertex) {
+  return std::find(vertices, vertices + arity, vertex) != vertices + arity;
+}
+
+// Number of vertices of the simplex with a smaller id than `vertex`: the
+// position `vertex` would take in the ascending tuple.
+int rankOf(const uint32_t* vertices, int arity, uint32_t vertex) {
+  int rank = 0;
+  for (int i = 0; i < arity; ++i) rank += vertices[i] < vertex;
+  return rank;
+}
+
+}  // namespace
+
+void gatherStar(SimplexStore& store, uint32_t v, std::vector<StarEntry>& star,
+                std::array<size_t, 5>& begin) {
+  star.clear();
+  StarEntry entry{};
+  entry.simplex = entry.copy = entry.added = kNoSimplex;
+  star.push_back(entry);
+  begin[0] = 0;
+  for (int d = 1; d <= SimplexStore::kMaxDimension; ++d) {
+    begin[size_t(d)] = star.size();
+    store.forEachIncident(d, v, [&](uint32_t simplex, uint32_t position) {
+      entry.simplex = simplex;
+      entry.dimension = uint8_t(d);
+      entry.position = uint8_t(position);
+      const uint32_t* vertices = store.vertices(d, simplex);
+      int n = 0;
+      for (int i = 0; i <= d; ++i)
+        if (i != int(position)) entry.others[n++] = vertices[i];
+      for (int i = 1; i < n; ++i)  // at most three: insertion sort
+        for (int j = i; j > 0 && entry.others[j - 1] > entry.others[j]; --j)
+          std::swap(entry.others[j - 1], entry.others[j]);
+      star.push_back(entry);
+    });
+    std::sort(star.begin() + std::ptrdiff_t(begin[size_t(d)]), star.end(),
+              [d](const StarEntry& a, const StarEntry& b) { return lessOthers(a.others, b.others, d); });
+  }
+  begin[4] = star.size();
+}
+
+const VertexSplitter::Entry* VertexSplitter::findFace(int dimension, const uint32_t* others) const {
+  if (dimension == 0) return &star_[0];
+  const auto first = star_.begin() + std::ptrdiff_t(begin_[size_t(dimension)]);
+  const auto last = star_.begin() + std::ptrdiff_t(begin_[size_t(dimension) + 1]);
+  const auto at = std::lower_bound(first, last, others, [dimension](const Entry& e, const uint32_t* o) {
+    return lessOthers(e.others, o, dimension);
+  });
+  if (at == last || lessOthers(others, at->others, dimension)) return nullptr;
+  return &*at;
+}
+
+uint8_t VertexSplitter::possibleCodes(const Entry& entry) const {
+  const int d = entry.dimension;
+  if (d == 0) return 0b1100;
+  uint8_t possible = d == SimplexStore::kMaxDimension ? 0b0111 : 0b1111;
+  // Every face of the simplex through v: drop one of the other vertices.
+  for (int skip = 0; skip < d; ++skip) {
+    uint32_t faceOthers[3];
+    int n = 0;
+    for (int i = 0; i < d; ++i)
+      if (i != skip) faceOthers[n++] = entry.others[i];
+    const Entry* face = findFace(d - 1, faceOthers);
+    if (face == nullptr) return 0;
+    possible &= kAllowedBy[face->code];
+  }
+  return possible;
+}
+
+int VertexSplitter::predictFlip(int dimension, uint32_t simplex, uint32_t v, uint32_t v2,
+                                int& voteClass) {
+  const int arity = dimension + 1;
+  const uint32_t* mine = store_.vertices(dimension, simplex);
+  const int myParity = store_.parity(dimension, simplex);
+  int keep = 0, flip = 0;
+  auto consider = [&](uint32_t other) {
+    if (other == simplex || (store_.flags(dimension, other) & SimplexStore::kUndecided)) return;
+    const uint32_t* theirs = store_.vertices(dimension, other);
+    // They are neighbours when they share all vertices but one each.
+    uint32_t mineOnly = 0, theirsOnly = 0;
+    int missing = 0;
+    for (int i = 0; i < arity; ++i) {
+      if (!containsVertex(theirs, arity, mine[i])) {
+        mineOnly = mine[i];
+        ++missing;
+      }
+      if (!containsVertex(mine, arity, theirs[i])) theirsOnly = theirs[i];
+    }
+    if (missing != 1) return;
+    // Orientation each induces on the shared facet; consistent neighbours
+    // induce opposite ones.
+    const int mySign = myParity ^ (rankOf(mine, arity, mineOnly) & 1);
+    const int theirSign =
+        store_.parity(dimension, other) ^ (rankOf(theirs, arity, theirsOnly) & 1);
+    if (mySign == theirSign)
+      ++flip;
+    else
+      ++keep;
+  };
+  store_.forEachIncident(dimension, v, [&](uint32_t other, uint32_t) { consider(other); });
+  store_.forEachIncident(dimension, v2, [&](uint32_t other, uint32_t) {
+    if (!containsVertex(store_.vertices(dimension, other), arity, v)) consider(other);
+  });
+  voteClass = keep + flip == 0 ? 0 : (keep == 0 || flip == 0) ? 1 : 2;
+  return flip > keep;
+}
+
+bool VertexSplitter::isFaceOfHigher(int dimension, uint32_t simplex, uint32_t v2) {
+  const uint32_t* mine = store_.vertices(dimension, simplex);
+  bool found = false;
+  store_.forEachIncident(dimension + 1, v2, [&](uint32_t higher, uint32_t) {
+    const uint32_t* theirs = store_.vertices(dimension + 1, higher);
+    bool all = true;
+    for (int i = 0; i <= dimension; ++i) all = all && containsVertex(theirs, dimension + 2, mine[i]);
+    found = found || all;
+  });
+  return found;
+}
+
+}  // namespace kdmesh

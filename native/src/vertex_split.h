@@ -1,0 +1,184 @@
+// The generalized vertex split (Popović & Hoppe), as coded by Gandoin &
+// Devillers: when a kd-tree cell with vertex V splits into two non-empty
+// halves, V becomes V1 (the first half; it keeps V's id) and V2 (a new id),
+// and every simplex S of V's star gets a code
+//   1: S goes to V1          2: S goes to V2          3: to both
+//   4: to both, plus S ∪ {V1, V2} one dimension higher.
+// The vertex V itself always goes to both: code 4 means the edge V1V2.
+//
+// Codes are taken in a canonical order both sides can reproduce: by
+// dimension, then by the sorted ids of the other vertices. Closure limits
+// each code by those of the simplex's faces through V (a face coded 1 forces
+// 1, a face coded 2 forces 2, a face coded 3 excludes 4, and the code of S
+// must allow its children's faces), so implied codes cost nothing; the rest
+// are coded with adaptive models per dimension and set of possible codes.
+//
+// Triangles and tetrahedra are oriented. A child that inherits its parent's
+// tuple keeps the parent's orientation; the second copy of a code-3 simplex
+// and the new simplex of a code 4 get one coded bit each, predicted from
+// the orientations of already decided neighbours that share a facet.
+//
+// One template serves both sides: on the encoder `Oracle` supplies the
+// decimation's answers and the range coder writes them; on the decoder the
+// range coder reads them and the oracle's values are ignored.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "kdmesh/kdmesh.h"
+#include "range_coder.h"
+#include "simplex_store.h"
+
+namespace kdmesh {
+
+// One byte per star entry, as the encoder's decimation records them.
+namespace split_record {
+constexpr uint8_t kCodeMask = 3;        // code - 1
+constexpr int kCopyTargetShift = 2;     // orientation of the code-3/4 copy
+constexpr int kNewTargetShift = 4;      // orientation of the code-4 simplex
+constexpr uint8_t kFree = 0;            // target: any orientation will do
+constexpr uint8_t kParity0 = 2, kParity1 = 3;
+inline uint8_t target(int parity) { return uint8_t(kParity0 + parity); }
+}  // namespace split_record
+
+// An entry of a vertex star in canonical order: by dimension, then by the
+// ascending ids of the simplex's other vertices. Entry 0 is the vertex.
+struct StarEntry {
+  uint32_t simplex;
+  uint32_t others[3];  // the other vertices, ascending
+  uint8_t dimension;
+  uint8_t position;    // of the vertex in the simplex's tuple
+  uint8_t code;
+  uint8_t record;
+  uint32_t copy, added;  // children made by codes 3 and 4
+};
+
+// Fills `star` with the star of `v`; begin[d] is the first entry of
+// dimension d, begin[4] the end.
+void gatherStar(SimplexStore& store, uint32_t v, std::vector<StarEntry>& star,
+                std::array<size_t, 5>& begin);
+
+class VertexSplitter {
+ public:
+  explicit VertexSplitter(SimplexStore& store) : store_(store) {}
+
+  // Splits `v` into `v` and `v2`. `next()` of the oracle gives the record
+  // byte of each star entry in canonical order. Returns false when the codes
+  // contradict each other or the store is full: corrupt data on the decoder.
+  template <class Coder, class Oracle>
+  bool split(Coder& coder, uint32_t v, uint32_t v2, Oracle&& oracle);
+
+  const ConnectivityStatistics& statistics() const { return statistics_; }
+
+ private:
+  using Entry = StarEntry;
+
+  // Possible codes as a bit set: bit c-1 for code c.
+  static constexpr uint8_t kAllowedBy[5] = {0, 0b0001, 0b0010, 0b0111, 0b1111};
+
+  uint8_t possibleCodes(const Entry& entry) const;
+  const Entry* findFace(int dimension, const uint32_t* others) const;
+  template <class Coder>
+  uint8_t codeSymbol(Coder& coder, int dimension, uint8_t possible, uint8_t code);
+  template <class Coder>
+  void decideOrientation(Coder& coder, int dimension, uint32_t simplex, uint32_t v, uint32_t v2,
+                         bool isCopy, uint8_t target);
+  int predictFlip(int dimension, uint32_t simplex, uint32_t v, uint32_t v2, int& voteClass);
+  bool isFaceOfHigher(int dimension, uint32_t simplex, uint32_t v2);
+
+  SimplexStore& store_;
+  std::vector<Entry> star_;
+  std::array<size_t, 5> begin_{};  // star_ entries of dimension d: [begin_[d], begin_[d+1])
+  // Code models: [dimension][possible set][step of the sequential binarisation].
+  BitModel codeModels_[4][16][3];
+  // Orientation models: [dimension - 2][copy or new][vote class][face of higher].
+  BitModel orientationModels_[2][2][3][2];
+  ConnectivityStatistics statistics_;
+};
+
+template <class Coder>
+uint8_t VertexSplitter::codeSymbol(Coder& coder, int dimension, uint8_t possible, uint8_t code) {
+  int step = 0;
+  for (uint8_t c = 1; c <= 4; ++c) {
+    if (!(possible & (1u << (c - 1)))) continue;
+    if ((possible >> c) == 0) return c;  // the last candidate left
+    if (coder.bit(codeModels_[dimension][possible][step], c == code)) return c;
+    ++step;
+  }
+  return 0;  // unreachable: `possible` is never empty here
+}
+
+template <class Coder>
+void VertexSplitter::decideOrientation(Coder& coder, int dimension, uint32_t simplex, uint32_t v,
+                                       uint32_t v2, bool isCopy, uint8_t target) {
+  int voteClass = 0;
+  const int predicted = predictFlip(dimension, simplex, v, v2, voteClass);
+  const int faceOfHigher = dimension < 3 && isFaceOfHigher(dimension, simplex, v2);
+  int flip = predicted;
+  if (target != split_record::kFree)
+    flip = store_.parity(dimension, simplex) != target - split_record::kParity0;
+  BitModel& model = orientationModels_[dimension - 2][isCopy][voteClass][faceOfHigher];
+  const bool mispredicted = coder.bit(model, flip != predicted);
+  flip = predicted ^ int(mispredicted);
+  uint8_t& flags = store_.flags(dimension, simplex);
+  if (flip) flags ^= SimplexStore::kFlipped;
+  flags &= uint8_t(~SimplexStore::kUndecided);
+  ++statistics_.orientationBits;
+  statistics_.orientationMispredicted += mispredicted;
+}
+
+template <class Coder, class Oracle>
+bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, Oracle&& oracle) {
+  gatherStar(store_, v, star_, begin_);
+  ++statistics_.vertexSplits;
+  for (Entry& entry : star_) {
+    entry.record = oracle();
+    const uint8_t possible = possibleCodes(entry);
+    if (possible == 0) return false;
+    entry.code = codeSymbol(coder, entry.dimension, possible,
+                            uint8_t((entry.record & split_record::kCodeMask) + 1));
+    ++statistics_.codes[entry.dimension][entry.code - 1];
+  }
+
+  for (int d = 1; d <= SimplexStore::kMaxDimension; ++d) store_.detach(d, v);
+  if (star_[0].code == 4) {
+    const uint32_t edge[2] = {v, v2};
+    if (store_.add(1, edge, 0) == kNoSimplex) return false;
+  }
+  for (size_t i = 1; i < star_.size(); ++i) {
+    Entry& entry = star_[i];
+    const int d = entry.dimension;
+    if (entry.code == 2) store_.replaceVertex(d, entry.simplex, v, v2);
+    store_.link(d, entry.simplex, entry.position);
+    if (entry.code < 3) continue;
+    const uint8_t undecided = d >= 2 ? SimplexStore::kUndecided : 0;
+    uint32_t tuple[5];
+    std::copy(store_.vertices(d, entry.simplex), store_.vertices(d, entry.simplex) + d + 1, tuple);
+    const uint8_t flipped = store_.flags(d, entry.simplex) & SimplexStore::kFlipped;
+    tuple[entry.position] = v2;
+    entry.copy = store_.add(d, tuple, uint8_t(flipped | undecided));
+    if (entry.copy == kNoSimplex) return false;
+    if (entry.code == 4) {
+      tuple[entry.position] = v;
+      tuple[d + 1] = v2;
+      entry.added = store_.add(d + 1, tuple, uint8_t(flipped | (d + 1 >= 2 ? SimplexStore::kUndecided : 0)));
+      if (entry.added == kNoSimplex) return false;
+    }
+  }
+
+  for (const Entry& entry : star_) {
+    const int d = entry.dimension;
+    if (entry.copy != kNoSimplex && d >= 2)
+      decideOrientation(coder, d, entry.copy, v, v2, true,
+                        uint8_t((entry.record >> split_record::kCopyTargetShift) & 3));
+    if (entry.added != kNoSimplex && d + 1 >= 2)
+      decideOrientation(coder, d + 1, entry.added, v, v2, false,
+                        uint8_t((entry.record >> split_record::kNewTargetShift) & 3));
+  }
+  return true;
+}
+
+}  // namespace kdmesh

@@ -1,0 +1,216 @@
+// Connectivity coding: exact round trips of simplicial complexes of every
+// kind, and the prefix property (every prefix is the projection of the input).
+#include <gtest/gtest.h>
+
+#include <set>
+
+#include "complexes.h"
+#include "shapes.h"
+#include "kdmesh/kdmesh.h"
+#include "test_support.h"
+
+namespace kdmesh::test {
+namespace {
+
+Complex roundTrip(const Complex& input, const EncodeOptions& options, EncodeResult* encoded = nullptr) {
+  EncodeResult result = encode(input, options);
+  EXPECT_TRUE(result.status.ok()) << result.status.message;
+  Complex output;
+  const Status status = decode(result.bytes.data(), result.bytes.size(), output);
+  EXPECT_TRUE(status.ok()) << status.message;
+  if (encoded) *encoded = std::move(result);
+  return output;
+}
+
+EncodeOptions exact() {
+  EncodeOptions o;
+  o.exact = true;
+  return o;
+}
+
+void expectExactRoundTrip(const Complex& input) {
+  const Complex output = roundTrip(input, exact());
+  EXPECT_EQ(output.vertexCount(), input.vertexCount());
+  EXPECT_EQ(canonicalForm(output), canonicalForm(input));
+}
+
+TEST(Connectivity, ClosedManifoldMeshes) {
+  expectExactRoundTrip(torusMesh(12, 20));
+  expectExactRoundTrip(sphereMesh(9, 14));
+}
+
+TEST(Connectivity, OpenMeshWithHoles) { expectExactRoundTrip(gridWithHoles(18)); }
+
+TEST(Connectivity, NonManifoldEdgesAndVertexTouchingSheets) {
+  Complex c;
+  // Four triangles on the edge (0, 1), a fin, and two sheets touching at vertex 0.
+  c.positions = {0, 0, 0, 1, 0, 0, 0, 1, 0, 0, -1, 0, 0, 0, 1, 0.5f, 0.5f, 0.5f,
+                 -1, -1, -1, -2, -1, -1, -1, -2, -1};
+  c.triangles = {0, 1, 2, 1, 0, 3, 0, 1, 4, 1, 0, 5, 0, 6, 7, 0, 8, 6};
+  expectExactRoundTrip(c);
+}
+
+TEST(Connectivity, TriangleSoupWithDuplicatedVertices) {
+  // Every triangle has its own three vertices, many at shared positions.
+  const Complex mesh = sphereMesh(7, 10);
+  Complex soup;
+  for (uint32_t v : mesh.triangles) {
+    soup.positions.insert(soup.positions.end(), &mesh.positions[3 * v], &mesh.positions[3 * v] + 3);
+    soup.triangles.push_back(uint32_t(soup.triangles.size()));
+  }
+  expectExactRoundTrip(soup);
+}
+
+TEST(Connectivity, PolylinesAndIsolatedPoints) {
+  Complex c;
+  c.positions = uniformCloud(60, 5);
+  for (uint32_t i = 0; i + 1 < 30; ++i) c.edges.insert(c.edges.end(), {i, i + 1});
+  c.edges.insert(c.edges.end(), {29, 0, 35, 36, 36, 37});  // a loop and a separate polyline
+  expectExactRoundTrip(c);  // vertices 30..34 and 38..59 are isolated points
+}
+
+TEST(Connectivity, TetrahedralMesh) { expectExactRoundTrip(tetrahedralBlock(4, 3)); }
+
+TEST(Connectivity, MixedDimensions) {
+  Complex c = tetrahedralBlock(1, 9);  // 8 vertices, 6 tetrahedra
+  const uint32_t base = uint32_t(c.vertexCount());
+  const std::vector<float> extra = uniformCloud(8, 11, 3.f);
+  c.positions.insert(c.positions.end(), extra.begin(), extra.end());
+  c.triangles.insert(c.triangles.end(), {0, base, base + 1, base + 1, base + 2, base + 3});
+  c.edges.insert(c.edges.end(), {base + 3, base + 4, 7, base + 5});
+  c.points.push_back(base + 6);
+  expectExactRoundTrip(c);
+}
+
+TEST(Connectivity, CoincidentVerticesAreSeparatedByConnectivity) {
+  // Quantized to 2 bits, this mesh has many vertices per grid point.
+  const Complex mesh = torusMesh(10, 16);
+  EncodeOptions o;
+  o.bits = 2;
+  const Complex output = roundTrip(mesh, o);
+  EXPECT_EQ(output.vertexCount(), mesh.vertexCount());
+  EXPECT_EQ(output.simplexCount(2), mesh.simplexCount(2));
+}
+
+TEST(Connectivity, RandomComplexesProperty) {
+  for (uint32_t seed = 1; seed <= 150; ++seed) {
+    const Complex c = randomComplex(seed, 4 + int(seed % 23), 1 + int(seed % 41));
+    SCOPED_TRACE(seed);
+    // Grid positions on 8 values per axis: coincident vertices abound.
+    expectExactRoundTrip(c);
+    if (HasFailure()) break;
+  }
+}
+
+TEST(Connectivity, RepairsAreCounted) {
+  Complex c;
+  c.positions = uniformCloud(6, 2);
+  c.triangles = {0, 1, 2, 2, 0, 1, 0, 0, 3, 3, 4, 5};  // a duplicate (rotated) and a degenerate
+  c.edges = {0, 1, 4, 5, 1, 3};                        // two faces of triangles, one new edge
+  c.points = {0, 3};
+  EncodeResult encoded = encode(c, exact());
+  ASSERT_TRUE(encoded.status.ok()) << encoded.status.message;
+  EXPECT_EQ(encoded.repairs.duplicate[2], 1u);
+  EXPECT_EQ(encoded.repairs.degenerate[2], 1u);
+  EXPECT_EQ(encoded.repairs.redundant[1], 2u);
+  EXPECT_EQ(encoded.repairs.redundant[0], 2u);
+  Complex output;
+  ASSERT_TRUE(decode(encoded.bytes.data(), encoded.bytes.size(), output).ok());
+  EXPECT_EQ(output.simplexCount(2), 2u);
+  EXPECT_EQ(output.simplexCount(1), 1u);
+  EXPECT_EQ(canonicalForm(output), canonicalForm(c));
+}
+
+TEST(Connectivity, BadIndicesAreRejected) {
+  Complex c;
+  c.positions = uniformCloud(3, 1);
+  c.triangles = {0, 1, 7};
+  const EncodeResult r = encode(c);
+  EXPECT_EQ(r.status.code, ErrorCode::InvalidInput);
+  EXPECT_NE(r.status.message.find("triangle 0 refers to vertex 7"), std::string::npos) << r.status.message;
+}
+
+// The complex of a prefix must be the input complex with every vertex
+// replaced by its ancestor at that prefix: same maximal simplices, and each
+// oriented like an input simplex of its dimension that projects onto it.
+void expectPrefixesAreProjections(const Complex& input, size_t chunkBytes) {
+  EncodeOptions o = exact();
+  o.chunkBytes = chunkBytes;
+  const EncodeResult encoded = encode(input, o);
+  ASSERT_TRUE(encoded.status.ok()) << encoded.status.message;
+  Decoder full;
+  ASSERT_TRUE(full.push(encoded.bytes.data(), encoded.bytes.size()).ok());
+  ASSERT_TRUE(full.complete());
+  const Complex final = full.snapshot();
+  const std::vector<uint32_t> parents = full.vertexParents();
+
+  std::vector<uint64_t> cuts;
+  for (const ChunkInfo& chunk : full.chunks()) cuts.push_back(chunk.offset);
+  cuts.push_back(encoded.bytes.size());
+  for (const uint64_t cut : cuts) {
+    Decoder decoder;
+    ASSERT_TRUE(decoder.push(encoded.bytes.data(), cut).ok());
+    if (!decoder.hasHeader()) continue;
+    const Complex prefix = decoder.snapshot();
+    const uint32_t count = uint32_t(prefix.vertexCount());
+    auto ancestor = [&](uint32_t v) {
+      while (v >= count) v = parents[v];
+      return v;
+    };
+    // Projected input: oriented simplices by ancestor ids.
+    std::map<std::vector<uint32_t>, std::set<int>> projected;  // sorted ids -> parities seen
+    const std::vector<uint32_t>* lists[4] = {&final.points, &final.edges, &final.triangles, &final.tetrahedra};
+    for (int d = 0; d <= 3; ++d)
+      for (size_t i = 0; i < lists[d]->size(); i += size_t(d + 1)) {
+        std::vector<uint32_t> v;
+        for (int k = 0; k <= d; ++k) v.push_back(ancestor((*lists[d])[i + size_t(k)]));
+        std::vector<uint32_t> sorted = v;
+        std::sort(sorted.begin(), sorted.end());
+        const bool collapsed = std::adjacent_find(sorted.begin(), sorted.end()) != sorted.end();
+        sorted.erase(std::unique(sorted.begin(), sorted.end()), sorted.end());
+        int inversions = 0;
+        for (size_t a = 0; a < v.size(); ++a)
+          for (size_t b = a + 1; b < v.size(); ++b) inversions += v[a] > v[b];
+        std::set<int>& parities = projected[sorted];
+        if (!collapsed && d >= 2) parities.insert(inversions & 1);
+      }
+    // Maximal projected simplices.
+    std::set<std::vector<uint32_t>> faces;
+    for (const auto& [s, parities] : projected)
+      for (int mask = 1; mask + 1 < (1 << s.size()); ++mask) {
+        std::vector<uint32_t> f;
+        for (size_t b = 0; b < s.size(); ++b)
+          if (mask >> b & 1) f.push_back(s[b]);
+        faces.insert(f);
+      }
+    std::set<std::vector<uint32_t>> expected, actual;
+    for (const auto& [s, parities] : projected)
+      if (!faces.count(s)) expected.insert(s);
+    const std::vector<uint32_t>* got[4] = {&prefix.points, &prefix.edges, &prefix.triangles, &prefix.tetrahedra};
+    for (int d = 0; d <= 3; ++d)
+      for (size_t i = 0; i < got[d]->size(); i += size_t(d + 1)) {
+        std::vector<uint32_t> v(got[d]->begin() + std::ptrdiff_t(i), got[d]->begin() + std::ptrdiff_t(i) + d + 1);
+        std::vector<uint32_t> sorted = v;
+        std::sort(sorted.begin(), sorted.end());
+        ASSERT_EQ(std::adjacent_find(sorted.begin(), sorted.end()), sorted.end()) << "repeated vertex at " << cut;
+        actual.insert(sorted);
+        const std::set<int>& parities = projected[sorted];
+        if (d >= 2 && !parities.empty()) {
+          int inversions = 0;
+          for (size_t a = 0; a < v.size(); ++a)
+            for (size_t b = a + 1; b < v.size(); ++b) inversions += v[a] > v[b];
+          EXPECT_TRUE(parities.count(inversions & 1)) << "orientation at byte " << cut << " of " << encoded.bytes.size() << " dim " << d << " simplex " << ::testing::PrintToString(v);
+        }
+      }
+    ASSERT_EQ(actual, expected) << "prefix of " << cut << " bytes";
+  }
+}
+
+TEST(Connectivity, EveryChunkPrefixIsTheProjectionOfTheInput) {
+  expectPrefixesAreProjections(torusMesh(14, 22), 64);
+  expectPrefixesAreProjections(tetrahedralBlock(3, 5), 64);
+  expectPrefixesAreProjections(randomComplex(77, 40, 60), 64);
+}
+
+}  // namespace
+}  // namespace kdmesh::test
