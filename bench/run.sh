@@ -23,7 +23,8 @@ cmake -S . -B build-bench -DCMAKE_BUILD_TYPE=Release -DKDMESH_BUILD_BENCH=ON \
   -DKDMESH_BUILD_TESTS=OFF >/dev/null
 cmake --build build-bench -j"$(nproc)" >/dev/null
 
-dragon=$(sh scripts/models.sh)
+sh scripts/models.sh
+dragon=build/models/dragon_vrip.ply
 models="$dragon"
 if [ -f ../shared/models/bunny.obj ]; then models="../shared/models/bunny.obj $models"; fi
 bits="--bits 12 --bits 16"

@@ -3,4 +3,5 @@
 set -eu
 cd "$(dirname "$0")/.."
 sh scripts/build.sh
+sh scripts/models.sh
 ctest --test-dir build --output-on-failure -j"$(nproc)"
