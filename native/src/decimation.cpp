@@ -40,7 +40,7 @@ Status buildInputComplex(const Complex& complex, const std::vector<uint32_t>& id
                          SimplexStore& store, InputSummary& summary) {
   const size_t n = complex.vertexCount();
   summary = InputSummary{};
-  store.reset(uint32_t(n));
+  store.reset(uint32_t(n), true);
   const std::vector<uint32_t>* lists[4] = {&complex.points, &complex.edges, &complex.triangles,
                                            &complex.tetrahedra};
   for (int d = 0; d <= 3; ++d) {

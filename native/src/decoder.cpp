@@ -68,6 +68,7 @@ struct Decoder::State {
   std::optional<VertexSplitter> splitter;
   uint32_t nextVertex = 1;
   std::vector<uint32_t> parents{0};  // the vertex each vertex was split from
+  Complex finalComplex;              // simplices, once complete
 
   explicit State(const DecoderOptions& o) : options(o) {}
 
@@ -90,7 +91,7 @@ struct Decoder::State {
     singleLevelEnd = singles.size();
     connectivity = header.maxDimension > 0;
     if (connectivity) {
-      store.reset(header.vertexCount);
+      store.reset(header.vertexCount, false);
       const std::array<uint64_t, 4> caps = simplexCaps(header);
       for (int d = 1; d <= 3; ++d) store.setCapacity(d, uint32_t(std::min<uint64_t>(caps[size_t(d)], 0xffffffffu)));
       splitter.emplace(store);
@@ -129,9 +130,9 @@ struct Decoder::State {
 
   // The complete complex must have the maximal simplices the header
   // announced: a last line of defence against corrupt streams with valid
-  // checksums.
+  // checksums. The complex is kept for snapshot().
   Status checkFinalCounts() {
-    Complex complex;
+    Complex& complex = finalComplex;
     appendSimplices(complex);
     for (int d = 0; d <= 3; ++d)
       if (complex.simplexCount(d) != header.simplexCounts[size_t(d)])
@@ -211,33 +212,16 @@ struct Decoder::State {
   // Appends the maximal simplices of the current complex, oriented, and its
   // isolated vertices.
   void appendSimplices(Complex& out) const {
-    auto append = [&](int d, uint32_t simplex, std::vector<uint32_t>& list) {
-      const uint32_t* v = store.vertices(d, simplex);
-      const size_t at = list.size();
-      list.insert(list.end(), v, v + d + 1);
-      if (store.flags(d, simplex) & SimplexStore::kFlipped) std::swap(list[at], list[at + 1]);
-    };
-    std::vector<uint8_t> covered;
     std::vector<uint32_t>* lists[4] = {nullptr, &out.edges, &out.triangles, &out.tetrahedra};
-    std::vector<uint8_t> coveredBelow;
-    for (int d = 3; d >= 1; --d) {
-      // Faces of live simplices of dimension d + 1 are not maximal.
-      coveredBelow.assign(d > 1 ? store.size(d - 1) : 0, 0);
+    for (int d = 1; d <= 3; ++d) {
+      std::vector<uint32_t>& list = *lists[d];
       for (uint32_t simplex = 0; simplex < store.size(d); ++simplex) {
-        if (!(store.flags(d, simplex) & SimplexStore::kAlive)) continue;
-        if (covered.empty() || !covered[simplex]) append(d, simplex, *lists[d]);
-        if (d == 1) continue;
+        if (!(store.flags(d, simplex) & SimplexStore::kAlive) || store.isFace(d, simplex)) continue;
         const uint32_t* v = store.vertices(d, simplex);
-        for (int skip = 0; skip <= d; ++skip) {
-          uint32_t face[3];
-          int n = 0;
-          for (int i = 0; i <= d; ++i)
-            if (i != skip) face[n++] = v[i];
-          const uint32_t f = store.find(d - 1, face);
-          if (f != kNoSimplex) coveredBelow[f] = 1;
-        }
+        const size_t at = list.size();
+        list.insert(list.end(), v, v + d + 1);
+        if (store.flags(d, simplex) & SimplexStore::kFlipped) std::swap(list[at], list[at + 1]);
       }
-      covered.swap(coveredBelow);
     }
     for (uint32_t v = 0; v < nextVertex; ++v)
       if (!store.hasIncident(1, v)) out.points.push_back(v);
@@ -383,7 +367,14 @@ void Decoder::snapshot(Complex& out) const {
         out.positions[size_t(cell.vertex) * 3 + size_t(a)] = s.dequantizer->position(a, lo, hi);
       }
     });
-    s.appendSimplices(out);
+    if (s.complete()) {
+      out.points = s.finalComplex.points;
+      out.edges = s.finalComplex.edges;
+      out.triangles = s.finalComplex.triangles;
+      out.tetrahedra = s.finalComplex.tetrahedra;
+    } else {
+      s.appendSimplices(out);
+    }
     return;
   }
   const bool complete = s.complete();

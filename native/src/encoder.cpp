@@ -240,7 +240,7 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options) {
   RangeEncoder& coder = chunks.coder();
   CountCoder counts(schedule.levels);
   SimplexStore forward;
-  forward.reset(header.vertexCount);
+  forward.reset(header.vertexCount, false);
   VertexSplitter splitter(forward);
   size_t splitIndex = 0;
   double connectivityBits = 0;

@@ -19,10 +19,11 @@ int tupleParity(const uint32_t* v, int n) {
   return inversions & 1;
 }
 
-void SimplexStore::reset(uint32_t vertexCapacity) {
+void SimplexStore::reset(uint32_t vertexCapacity, bool indexed) {
+  indexed_ = indexed;
   for (int d = 1; d <= kMaxDimension; ++d) {
     pool_[d] = Pool{};
-    pool_[d].table.assign(16, kNoSimplex);
+    if (indexed) pool_[d].table.assign(16, kNoSimplex);
     heads_[d].assign(vertexCapacity, kNoSimplex);
     live_[d] = 0;
   }
@@ -99,8 +100,10 @@ uint32_t SimplexStore::add(int dimension, const uint32_t* vertices, uint8_t flag
   pool.next.resize(pool.next.size() + arity);
   pool.flags.push_back(uint8_t(flags | kAlive));
   ++live_[dimension];
-  if (size_t(live_[dimension]) * 2 > pool.table.size()) grow(dimension);
-  insertIndex(dimension, simplex);
+  if (indexed_) {
+    if (size_t(live_[dimension]) * 2 > pool.table.size()) grow(dimension);
+    insertIndex(dimension, simplex);
+  }
   for (uint32_t i = 0; i < arity; ++i) link(dimension, simplex, i);
   return simplex;
 }
@@ -116,16 +119,16 @@ uint32_t SimplexStore::find(int dimension, const uint32_t* vertices) const {
 }
 
 void SimplexStore::kill(int dimension, uint32_t simplex) {
-  eraseIndex(dimension, simplex);
+  if (indexed_) eraseIndex(dimension, simplex);
   pool_[dimension].flags[simplex] &= uint8_t(~kAlive);
   --live_[dimension];
 }
 
 void SimplexStore::replaceVertex(int dimension, uint32_t simplex, uint32_t from, uint32_t to) {
-  eraseIndex(dimension, simplex);
+  if (indexed_) eraseIndex(dimension, simplex);
   uint32_t* v = &pool_[dimension].vertices[size_t(simplex) * size_t(dimension + 1)];
   *std::find(v, v + dimension + 1, from) = to;
-  insertIndex(dimension, simplex);
+  if (indexed_) insertIndex(dimension, simplex);
 }
 
 int SimplexStore::parity(int dimension, uint32_t simplex) const {
@@ -138,6 +141,23 @@ bool SimplexStore::hasIncident(int dimension, uint32_t vertex) const {
   const uint32_t arity = uint32_t(dimension + 1);
   for (uint32_t slot = heads_[dimension][vertex]; slot != kNoSimplex; slot = pool.next[slot])
     if (pool.flags[slot / arity] & kAlive) return true;
+  return false;
+}
+
+bool SimplexStore::isFace(int dimension, uint32_t simplex) const {
+  if (dimension >= kMaxDimension) return false;
+  const uint32_t* mine = vertices(dimension, simplex);
+  const Pool& higher = pool_[dimension + 1];
+  const uint32_t arity = uint32_t(dimension + 2);
+  for (uint32_t slot = heads_[dimension + 1][mine[0]]; slot != kNoSimplex; slot = higher.next[slot]) {
+    const uint32_t candidate = slot / arity;
+    if (!(higher.flags[candidate] & kAlive)) continue;
+    const uint32_t* theirs = &higher.vertices[size_t(candidate) * arity];
+    bool all = true;
+    for (int i = 1; i <= dimension && all; ++i)
+      all = std::find(theirs, theirs + arity, mine[i]) != theirs + arity;
+    if (all) return true;
+  }
   return false;
 }
 

@@ -35,7 +35,10 @@ class SimplexStore {
     kUndecided = 8,   // orientation not yet decoded in the current split
   };
 
-  void reset(uint32_t vertexCapacity);
+  // `indexed`: keep the hash index that find() needs. The decoder never
+  // looks a simplex up by its vertices, so it saves the index's time and
+  // memory.
+  void reset(uint32_t vertexCapacity, bool indexed);
   uint32_t vertexCapacity() const { return uint32_t(heads_[1].size()); }
   // Pool sizes (live and killed) may not exceed these; add() reports false.
   void setCapacity(int dimension, uint32_t maxSimplices);
@@ -44,7 +47,8 @@ class SimplexStore {
   // present; links it into its vertices' lists. Returns its index, or
   // kNoSimplex when the pool is at capacity.
   uint32_t add(int dimension, const uint32_t* vertices, uint8_t flags);
-  // Index of the live simplex with this vertex set, or kNoSimplex.
+  // Index of the live simplex with this vertex set, or kNoSimplex (indexed
+  // stores only).
   uint32_t find(int dimension, const uint32_t* vertices) const;
   void kill(int dimension, uint32_t simplex);
   // Replaces vertex `from` of a simplex by `to` (which it must not contain),
@@ -83,6 +87,8 @@ class SimplexStore {
     }
   }
   bool hasIncident(int dimension, uint32_t vertex) const;
+  // Whether a live simplex of dimension + 1 has this simplex as a face.
+  bool isFace(int dimension, uint32_t simplex) const;
 
   // Empties `vertex`'s list of `dimension` without touching the simplices;
   // the caller relinks every slot it keeps with link().
@@ -107,6 +113,7 @@ class SimplexStore {
   std::array<Pool, 4> pool_;                      // [0] unused
   std::array<std::vector<uint32_t>, 4> heads_;    // [0] unused
   std::array<uint32_t, 4> live_{};
+  bool indexed_ = true;
 };
 
 }  // namespace kdmesh

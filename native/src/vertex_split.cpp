@@ -117,16 +117,4 @@ int VertexSplitter::predictFlip(int dimension, uint32_t simplex, uint32_t v, uin
   return flip > keep;
 }
 
-bool VertexSplitter::isFaceOfHigher(int dimension, uint32_t simplex, uint32_t v2) {
-  const uint32_t* mine = store_.vertices(dimension, simplex);
-  bool found = false;
-  store_.forEachIncident(dimension + 1, v2, [&](uint32_t higher, uint32_t) {
-    const uint32_t* theirs = store_.vertices(dimension + 1, higher);
-    bool all = true;
-    for (int i = 0; i <= dimension; ++i) all = all && containsVertex(theirs, dimension + 2, mine[i]);
-    found = found || all;
-  });
-  return found;
-}
-
 }  // namespace kdmesh

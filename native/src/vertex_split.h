@@ -87,7 +87,6 @@ class VertexSplitter {
   void decideOrientation(Coder& coder, int dimension, uint32_t simplex, uint32_t v, uint32_t v2,
                          bool isCopy, uint8_t target);
   int predictFlip(int dimension, uint32_t simplex, uint32_t v, uint32_t v2, int& voteClass);
-  bool isFaceOfHigher(int dimension, uint32_t simplex, uint32_t v2);
 
   SimplexStore& store_;
   std::vector<Entry> star_;
@@ -116,7 +115,7 @@ void VertexSplitter::decideOrientation(Coder& coder, int dimension, uint32_t sim
                                        uint32_t v2, bool isCopy, uint8_t target) {
   int voteClass = 0;
   const int predicted = predictFlip(dimension, simplex, v, v2, voteClass);
-  const int faceOfHigher = dimension < 3 && isFaceOfHigher(dimension, simplex, v2);
+  const int faceOfHigher = store_.isFace(dimension, simplex);
   int flip = predicted;
   if (target != split_record::kFree)
     flip = store_.parity(dimension, simplex) != target - split_record::kParity0;
