@@ -6,42 +6,19 @@
 //
 // Prints one Markdown table row per model and quantization: size in bits per
 // vertex, warm median encode/decode times, throughput and kdmesh/Draco ratios.
-#include <algorithm>
-#include <chrono>
 #include <cstdio>
-#include <cstdlib>
-#include <cstring>
 #include <string>
 #include <vector>
 
+#include "bench_common.h"
 #include "draco/compression/decode.h"
 #include "draco/compression/encode.h"
 #include "draco/point_cloud/point_cloud_builder.h"
-#include "kdmesh/io.h"
-#include "kdmesh/kdmesh.h"
 
 namespace {
 
-using Clock = std::chrono::steady_clock;
-
-[[noreturn]] void fail(const std::string& message) {
-  std::fprintf(stderr, "kdmesh_bench_points: %s\n", message.c_str());
-  std::exit(1);
-}
-
-// Median wall time of `runs` calls after one warm-up call, in seconds.
-template <typename Body>
-double medianSeconds(int runs, Body&& body) {
-  body();
-  std::vector<double> times;
-  for (int i = 0; i < runs; ++i) {
-    const auto start = Clock::now();
-    body();
-    times.push_back(std::chrono::duration<double>(Clock::now() - start).count());
-  }
-  std::sort(times.begin(), times.end());
-  return times[times.size() / 2];
-}
+using bench::fail;
+using bench::medianSeconds;
 
 struct Measurement {
   size_t bytes = 0;
@@ -105,52 +82,27 @@ Measurement measureDraco(const std::vector<float>& positions, int bits, int comp
   return m;
 }
 
-std::string baseName(const std::string& path) {
-  const size_t slash = path.find_last_of('/');
-  return slash == std::string::npos ? path : path.substr(slash + 1);
-}
-
 }  // namespace
 
 int main(int argc, char** argv) {
-  int runs = 7;
-  std::vector<int> bitList;
-  std::vector<std::string> models;
-  for (int i = 1; i < argc; ++i) {
-    const std::string arg = argv[i];
-    if (arg == "--runs" && i + 1 < argc) {
-      runs = std::max(1, std::atoi(argv[++i]));
-    } else if (arg == "--bits" && i + 1 < argc) {
-      bitList.push_back(std::atoi(argv[++i]));
-    } else if (arg == "--help" || arg == "-h") {
-      std::printf("usage: kdmesh_bench_points [--runs N] [--bits B]... MODEL...\n");
-      return 0;
-    } else {
-      models.push_back(arg);
-    }
-  }
-  if (models.empty()) fail("no model given (try --help)");
-  if (bitList.empty()) bitList.push_back(12);
-
+  const bench::Arguments args =
+      bench::parseArguments(argc, argv, "usage: kdmesh_bench_points [--runs N] [--bits B]... MODEL...");
+  const int runs = args.runs;
   std::printf("| model | vertices | bits | kdmesh bpv | Draco -cl 10 bpv | size ratio | "
               "kdmesh encode Mpts/s | kdmesh decode Mpts/s | Draco encode Mpts/s | "
               "Draco decode Mpts/s | encode time ratio | decode time ratio |\n");
   std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
-  for (const std::string& path : models) {
-    kdmesh::Complex complex;
-    kdmesh::io::Notes notes;
-    if (kdmesh::Status status = kdmesh::io::readFile(path, complex, notes); !status.ok()) {
-      fail(path + ": " + status.message);
-    }
+  for (const std::string& path : args.models) {
+    kdmesh::Complex complex = bench::readModel(path);
     kdmesh::Complex cloud;  // vertices only: this is the point-cloud benchmark
     cloud.positions = std::move(complex.positions);
     const double n = static_cast<double>(cloud.vertexCount());
-    for (int bits : bitList) {
+    for (int bits : args.bits) {
       const Measurement ours = measureKdmesh(cloud, bits, runs);
       const Measurement draco = measureDraco(cloud.positions, bits, 10, runs);
       std::printf("| %s | %zu | %d | %.3f | %.3f | %.3f | %.2f | %.2f | %.2f | %.2f | %.2f | "
                   "%.2f |\n",
-                  baseName(path).c_str(), cloud.vertexCount(), bits, 8.0 * ours.bytes / n,
+                  bench::baseName(path).c_str(), cloud.vertexCount(), bits, 8.0 * ours.bytes / n,
                   8.0 * draco.bytes / n, double(ours.bytes) / double(draco.bytes),
                   n / ours.encodeSeconds / 1e6, n / ours.decodeSeconds / 1e6,
                   n / draco.encodeSeconds / 1e6, n / draco.decodeSeconds / 1e6,

@@ -1,0 +1,127 @@
+// Mesh benchmark: kdmesh (geometry + connectivity, progressive) against
+// Draco's single-rate mesh coder (edgebreaker) at -cl 10 and -cl 7, both in
+// this process on the same triangles at the same quantization.
+//
+//   kdmesh_bench_mesh [--runs N] [--bits B]... MODEL...
+//
+// Prints a Markdown table: bits per vertex (connectivity / geometry / total)
+// for kdmesh, total for Draco, warm median encode/decode times, throughput
+// in M triangles/s, kdmesh/Draco time ratios, and kdmesh's operator counts.
+#include <cstdio>
+#include <string>
+#include <vector>
+
+#include "bench_common.h"
+#include "draco/compression/decode.h"
+#include "draco/compression/encode.h"
+#include "draco/mesh/triangle_soup_mesh_builder.h"
+
+namespace {
+
+using bench::fail;
+using bench::medianSeconds;
+
+struct Measurement {
+  size_t bytes = 0;
+  double encodeSeconds = 0, decodeSeconds = 0;
+};
+
+// The mesh as Draco's own OBJ/PLY loaders build it: a soup of corners whose
+// equal positions are merged.
+std::unique_ptr<draco::Mesh> dracoMesh(const kdmesh::Complex& complex) {
+  const size_t triangles = complex.triangles.size() / 3;
+  draco::TriangleSoupMeshBuilder builder;
+  builder.Start(int(triangles));
+  const int position = builder.AddAttribute(draco::GeometryAttribute::POSITION, 3, draco::DT_FLOAT32);
+  for (size_t t = 0; t < triangles; ++t) {
+    const float* corner[3];
+    for (int c = 0; c < 3; ++c) corner[c] = &complex.positions[3 * size_t(complex.triangles[3 * t + size_t(c)])];
+    builder.SetAttributeValuesForFace(position, draco::FaceIndex(uint32_t(t)), corner[0], corner[1], corner[2]);
+  }
+  return builder.Finalize();
+}
+
+Measurement measureDraco(const draco::Mesh& mesh, int bits, int level, int runs, size_t triangles) {
+  draco::Encoder encoder;
+  encoder.SetAttributeQuantization(draco::GeometryAttribute::POSITION, bits);
+  encoder.SetSpeedOptions(10 - level, 10 - level);
+  draco::EncoderBuffer buffer;
+  Measurement m;
+  m.encodeSeconds = medianSeconds(runs, [&] {
+    buffer.Clear();
+    const draco::Status status = encoder.EncodeMeshToBuffer(mesh, &buffer);
+    if (!status.ok()) fail("draco encode: " + status.error_msg_string());
+  });
+  m.bytes = buffer.size();
+  size_t faces = 0;
+  m.decodeSeconds = medianSeconds(runs, [&] {
+    draco::DecoderBuffer input;
+    input.Init(buffer.data(), buffer.size());
+    draco::Decoder decoder;
+    auto decoded = decoder.DecodeMeshFromBuffer(&input);
+    if (!decoded.ok()) fail("draco decode: " + decoded.status().error_msg_string());
+    faces = decoded.value()->num_faces();
+  });
+  if (faces != triangles) fail("draco decoded a different triangle count");
+  return m;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const bench::Arguments args =
+      bench::parseArguments(argc, argv, "usage: kdmesh_bench_mesh [--runs N] [--bits B]... MODEL...");
+  std::printf("| model | vertices | triangles | bits | kdmesh conn / geom / total bpv | Draco -cl 10 bpv | "
+              "Draco -cl 7 bpv | size ratio vs -cl 10 | kdmesh encode Mtri/s | kdmesh decode Mtri/s | "
+              "Draco -cl 10 encode Mtri/s | Draco -cl 10 decode Mtri/s | encode time ratio | "
+              "decode time ratio |\n");
+  std::printf("|---|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+  std::string operators;
+  for (const std::string& path : args.models) {
+    const kdmesh::Complex model = bench::readModel(path);
+    const double n = double(model.vertexCount()), triangles = double(model.simplexCount(2));
+    const std::unique_ptr<draco::Mesh> mesh = dracoMesh(model);
+    for (const int bits : args.bits) {
+      kdmesh::EncodeOptions options;
+      options.bits = bits;
+      kdmesh::EncodeResult encoded;
+      Measurement ours;
+      ours.encodeSeconds = medianSeconds(args.runs, [&] { encoded = kdmesh::encode(model, options); });
+      if (!encoded.status.ok()) fail("kdmesh encode: " + encoded.status.message);
+      ours.bytes = encoded.bytes.size();
+      kdmesh::Complex decoded;
+      ours.decodeSeconds = medianSeconds(args.runs, [&] {
+        const kdmesh::Status s = kdmesh::decode(encoded.bytes.data(), encoded.bytes.size(), decoded);
+        if (!s.ok()) fail("kdmesh decode: " + s.message);
+      });
+      if (decoded.simplexCount(2) != model.simplexCount(2)) fail("kdmesh decoded a different triangle count");
+      const Measurement draco10 = measureDraco(*mesh, bits, 10, args.runs, size_t(triangles));
+      const Measurement draco7 = measureDraco(*mesh, bits, 7, args.runs, size_t(triangles));
+      std::printf("| %s | %.0f | %.0f | %d | %.2f / %.2f / %.2f | %.2f | %.2f | %.3f | %.2f | %.2f | %.2f | "
+                  "%.2f | %.2f | %.2f |\n",
+                  bench::baseName(path).c_str(), n, triangles, bits, encoded.cost.connectivityBits / n,
+                  encoded.cost.geometryBits / n, 8.0 * double(ours.bytes) / n, 8.0 * double(draco10.bytes) / n,
+                  8.0 * double(draco7.bytes) / n, double(ours.bytes) / double(draco10.bytes),
+                  triangles / ours.encodeSeconds / 1e6, triangles / ours.decodeSeconds / 1e6,
+                  triangles / draco10.encodeSeconds / 1e6, triangles / draco10.decodeSeconds / 1e6,
+                  ours.encodeSeconds / draco10.encodeSeconds, ours.decodeSeconds / draco10.decodeSeconds);
+      std::fflush(stdout);
+      const kdmesh::ConnectivityStatistics& st = encoded.statistics;
+      char line[512];
+      std::snprintf(line, sizeof line,
+                    "| %s | %d | %llu | %llu | %.1f %% | %llu / %llu / %llu / %llu | %llu / %llu / %llu / %llu | %.1f %% |\n",
+                    bench::baseName(path).c_str(), bits, (unsigned long long)(n - 1),
+                    (unsigned long long)st.vertexSplits, 100.0 * double(st.vertexSplits) / (n - 1),
+                    (unsigned long long)st.codes[1][0], (unsigned long long)st.codes[1][1],
+                    (unsigned long long)st.codes[1][2], (unsigned long long)st.codes[1][3],
+                    (unsigned long long)st.codes[2][0], (unsigned long long)st.codes[2][1],
+                    (unsigned long long)st.codes[2][2], (unsigned long long)st.codes[2][3],
+                    st.orientationBits ? 100.0 * double(st.orientationMispredicted) / double(st.orientationBits) : 0.0);
+      operators += line;
+    }
+  }
+  std::printf("\n| model | bits | merges (n - 1) | generalized vertex splits | share | edge codes 1/2/3/4 | "
+              "triangle codes 1/2/3/4 | orientation mispredicted |\n");
+  std::printf("|---|---:|---:|---:|---:|---|---|---:|\n%s", operators.c_str());
+  return 0;
+}
