@@ -102,7 +102,7 @@ inline Complex tetrahedralBlock(int n, uint32_t seed) {
             t[s + 1] = id(p[0], p[1], p[2]);
           }
           // Odd permutations of the axes give negatively oriented paths.
-          const bool odd = (perm[0] > perm[1]) + (perm[0] > perm[2]) + (perm[1] > perm[2]) & 1;
+          const bool odd = ((perm[0] > perm[1]) + (perm[0] > perm[2]) + (perm[1] > perm[2])) & 1;
           if (odd) std::swap(t[2], t[3]);
           c.tetrahedra.insert(c.tetrahedra.end(), t, t + 4);
         }

@@ -154,9 +154,6 @@ TEST(PointCodec, RejectsBadOptionsAndEmptyInput) {
   EXPECT_EQ(encode(pointCloud({1, 2, 3}), options).status.code, ErrorCode::InvalidArgument);
   EXPECT_EQ(encode(pointCloud({}), EncodeOptions{}).status.code, ErrorCode::InvalidInput);
   EXPECT_EQ(encode(pointCloud({1, 2}), EncodeOptions{}).status.code, ErrorCode::InvalidArgument);
-  Complex withTriangles = pointCloud(uniformCloud(3, 1));
-  withTriangles.triangles = {0, 1, 2};
-  EXPECT_EQ(encode(withTriangles, EncodeOptions{}).status.code, ErrorCode::Unsupported);
 }
 
 TEST(PointCodec, EncodingIsDeterministic) {

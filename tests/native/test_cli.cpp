@@ -1,0 +1,391 @@
+// The kdmesh command-line tool, run as a separate process in a temporary
+// directory: round trips through every output format, progressive prefixes,
+// info output, and error handling (exit code, one-line message, no crash).
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cfloat>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <string>
+#include <vector>
+
+#include "kdmesh/io.h"
+#include "shapes.h"
+#include "test_support.h"
+
+#ifndef KDMESH_CLI_PATH
+#error "KDMESH_CLI_PATH must name the kdmesh executable"
+#endif
+
+namespace kdmesh::test {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CliRun {
+  int exitCode = -1;
+  int signal = 0;  // non-zero when the process died of a signal
+  std::string out, err;
+};
+
+std::string readWhole(const fs::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+std::vector<uint8_t> readBytes(const fs::path& path) {
+  const std::string s = readWhole(path);
+  return std::vector<uint8_t>(s.begin(), s.end());
+}
+
+void writeWhole(const fs::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+}
+
+void writeBytes(const fs::path& path, const std::vector<uint8_t>& bytes) {
+  std::ofstream out(path, std::ios::binary);
+  out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+}
+
+// What a terminal shows of some stderr text: each line from its last '\r'
+// on, blank lines dropped.
+std::vector<std::string> visibleLines(const std::string& text) {
+  std::vector<std::string> lines;
+  size_t start = 0;
+  while (start < text.size()) {
+    size_t end = text.find('\n', start);
+    if (end == std::string::npos) end = text.size();
+    std::string line = text.substr(start, end - start);
+    const size_t cr = line.rfind('\r');
+    if (cr != std::string::npos) line = line.substr(cr + 1);
+    if (line.find_first_not_of(' ') != std::string::npos) lines.push_back(line);
+    start = end + 1;
+  }
+  return lines;
+}
+
+class CliTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    std::string pattern = (fs::temp_directory_path() / "kdmesh_cli_test_XXXXXX").string();
+    ASSERT_NE(mkdtemp(pattern.data()), nullptr) << std::strerror(errno);
+    dir_ = pattern;
+  }
+  void TearDown() override {
+    std::error_code ignored;
+    fs::remove_all(dir_, ignored);
+  }
+
+  fs::path at(const std::string& name) const { return dir_ / name; }
+
+  // Runs the tool in the temporary directory with `args` (file names
+  // relative to it). exec replaces the shell, so that a crash shows as a
+  // signal rather than as the shell's exit code.
+  CliRun run(const std::string& args) const {
+    const std::string out = at("stdout.txt").string(), err = at("stderr.txt").string();
+    const std::string command = "cd '" + dir_.string() + "' && exec '" KDMESH_CLI_PATH "' " +
+                                args + " <" "/dev/null >'" + out + "' 2>'" + err + "'";
+    const int status = std::system(command.c_str());
+    CliRun r;
+    if (WIFSIGNALED(status)) r.signal = WTERMSIG(status);
+    if (WIFEXITED(status)) r.exitCode = WEXITSTATUS(status);
+    r.out = readWhole(out);
+    r.err = readWhole(err);
+    return r;
+  }
+
+  // A successful run: exit 0, which the message shows otherwise.
+  CliRun runOk(const std::string& args) const {
+    CliRun r = run(args);
+    EXPECT_EQ(r.exitCode, 0) << "kdmesh " << args << "\nstderr: " << r.err;
+    return r;
+  }
+
+  // A failed run: a non-zero exit code, not a crash, and one line on stderr
+  // starting with "kdmesh: error:". Returns that line.
+  std::string expectError(const std::string& args) const {
+    const CliRun r = run(args);
+    EXPECT_EQ(r.signal, 0) << "kdmesh " << args << " crashed";
+    EXPECT_GT(r.exitCode, 0) << "kdmesh " << args;
+    EXPECT_LT(r.exitCode, 128) << "kdmesh " << args;
+    const std::vector<std::string> lines = visibleLines(r.err);
+    EXPECT_EQ(lines.size(), 1u) << "kdmesh " << args << "\nstderr: " << r.err;
+    if (lines.empty()) return {};
+    EXPECT_EQ(lines.back().rfind("kdmesh: error:", 0), 0u)
+        << "kdmesh " << args << "\nstderr: " << r.err;
+    EXPECT_FALSE(r.err.empty() || r.err.back() != '\n') << "unterminated: " << r.err;
+    return lines.back();
+  }
+
+  Complex readModel(const std::string& name) const {
+    Complex c;
+    io::Notes notes;
+    const Status status = io::readFile(at(name).string(), c, notes);
+    EXPECT_TRUE(status.ok()) << name << ": " << status.message;
+    return c;
+  }
+
+  void writeModel(const std::string& name, const Complex& c) const {
+    const Status status = io::writeFile(at(name).string(), c);
+    ASSERT_TRUE(status.ok()) << name << ": " << status.message;
+  }
+
+  fs::path dir_;
+};
+
+// A cloud with floats that text output and exact coding must not disturb.
+std::vector<float> awkwardCloud(size_t n, uint32_t seed) {
+  std::vector<float> p = clusteredCloud(n, seed);
+  const float awkward[] = {-0.0f, 0.0f,     1e-45f,  FLT_MIN,  -1e-30f, 0.123456791f,
+                           1e30f, -3e38f, 16777215.0f, std::nextafter(1.0f, 2.0f),
+                           1.0f / 3.0f, 0.1f};
+  for (size_t i = 0; i + 2 < std::size(awkward); i += 3) {
+    p.insert(p.end(), awkward + i, awkward + i + 3);
+  }
+  return p;
+}
+
+TEST_F(CliTest, HelpExitsZeroAndListsTheCommands) {
+  const CliRun r = runOk("--help");
+  EXPECT_EQ(r.signal, 0);
+  for (const char* command : {"encode", "decode", "info"}) {
+    EXPECT_NE(r.out.find(command), std::string::npos) << r.out;
+  }
+  const CliRun encodeHelp = runOk("encode --help");
+  for (const char* option : {"--bits", "--exact", "--output"}) {
+    EXPECT_NE(encodeHelp.out.find(option), std::string::npos) << encodeHelp.out;
+  }
+}
+
+TEST_F(CliTest, ExactRoundTripThroughEveryOutputFormatIsBitExact) {
+  const std::vector<float> input = awkwardCloud(4000, 31);
+  writeModel("cloud.ply", pointCloud(input));
+  writeModel("cloud.xyz", pointCloud(input));
+  for (const char* source : {"cloud.ply", "cloud.xyz"}) {
+    SCOPED_TRACE(source);
+    runOk(std::string("encode ") + source + " -o exact.kdm --exact");
+    for (const char* output : {"out.ply", "out.obj", "out.xyz", "out.off"}) {
+      SCOPED_TRACE(output);
+      runOk(std::string("decode exact.kdm -o ") + output);
+      const Complex decoded = readModel(output);
+      EXPECT_EQ(sortedBitPatterns(decoded.positions), sortedBitPatterns(input));
+      EXPECT_FALSE(decoded.hasSimplices());
+    }
+    runOk("decode exact.kdm --ascii -o ascii.ply");
+    EXPECT_EQ(readWhole(at("ascii.ply")).rfind("ply\nformat ascii 1.0\n", 0), 0u);
+    EXPECT_EQ(sortedBitPatterns(readModel("ascii.ply").positions), sortedBitPatterns(input));
+  }
+}
+
+TEST_F(CliTest, GridRoundTripIsWithinHalfAStep) {
+  const std::vector<float> input = sphereSurface(5000, 32);
+  writeModel("sphere.ply", pointCloud(input));
+  runOk("encode sphere.ply -o grid.kdm --bits 12");
+  const std::vector<uint8_t> stream = readBytes(at("grid.kdm"));
+  Decoder decoder;
+  ASSERT_TRUE(decoder.push(stream.data(), stream.size()).ok());
+  ASSERT_TRUE(decoder.finish().ok());
+  const Header& h = decoder.header();
+  EXPECT_EQ(h.bits, 12);
+  ASSERT_GT(h.step, 0);
+  // Where the format puts every input coordinate: its nearest grid line.
+  std::vector<float> expected(input.size());
+  for (size_t i = 0; i < input.size(); ++i) {
+    const size_t a = i % 3;
+    const double q = std::llround((double(input[i]) - h.origin[a]) / h.step);
+    expected[i] = float(h.origin[a] + q * h.step);
+    ASSERT_LE(std::abs(double(expected[i]) - input[i]),
+              h.step * 0.5 * (1 + 1e-9) + std::abs(double(input[i])) * 1.2e-7);
+  }
+  for (const char* output : {"grid.ply", "grid.obj", "grid.xyz"}) {
+    SCOPED_TRACE(output);
+    runOk(std::string("decode grid.kdm -o ") + output);
+    const Complex decoded = readModel(output);
+    ASSERT_EQ(decoded.vertexCount(), input.size() / 3);
+    EXPECT_EQ(sortedBitPatterns(decoded.positions), sortedBitPatterns(expected));
+  }
+}
+
+TEST_F(CliTest, DecodingAPrefixGivesACoarserCloud) {
+  const std::vector<float> input = uniformCloud(5000, 33);
+  writeModel("cloud.xyz", pointCloud(input));
+  runOk("encode cloud.xyz -o cloud.kdm --bits 14");
+  const std::vector<uint8_t> stream = readBytes(at("cloud.kdm"));
+  ASSERT_GT(stream.size(), 4000u);
+  size_t previous = 0;
+  for (size_t bytes : {size_t{1200}, size_t{4000}, stream.size(), stream.size() + 100}) {
+    SCOPED_TRACE(bytes);
+    runOk("decode cloud.kdm --bytes " + std::to_string(bytes) + " -o coarse.xyz");
+    const Complex coarse = readModel("coarse.xyz");
+    EXPECT_GE(coarse.vertexCount(), 1u);
+    EXPECT_LE(coarse.vertexCount(), input.size() / 3);
+    EXPECT_GE(coarse.vertexCount(), previous);  // more bytes, finer model
+    previous = coarse.vertexCount();
+    if (bytes < stream.size()) {
+      EXPECT_LT(coarse.vertexCount(), input.size() / 3);
+      // Every input point lies within the decoder's error bound of the
+      // coarse model.
+      Decoder decoder;
+      ASSERT_TRUE(decoder.push(stream.data(), bytes).ok());
+      const double bound = decoder.errorBound();
+      EXPECT_EQ(decoder.snapshot().vertexCount(), coarse.vertexCount());
+      EXPECT_LE(maxNearestDistance(input, coarse.positions, bound * 1.001 + 1e-6),
+                bound * 1.001 + 1e-6);
+    } else {
+      EXPECT_EQ(coarse.vertexCount(), input.size() / 3);
+    }
+  }
+}
+
+TEST_F(CliTest, InfoPrintsHeaderFieldsAndBitsPerVertex) {
+  writeModel("cloud.ply", pointCloud(torusSurface(3000, 34)));
+  runOk("-q encode cloud.ply -o cloud.kdm --bits 10");
+  const size_t size = fs::file_size(at("cloud.kdm"));
+
+  const CliRun text = runOk("info cloud.kdm");
+  EXPECT_NE(text.out.find("vertices        3000\n"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find(std::to_string(size) + " bytes"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("grid, 10 bits"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("bits/vertex"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("chunks"), std::string::npos) << text.out;
+
+  const CliRun json = runOk("info --json cloud.kdm");
+  const std::string& j = json.out;
+  ASSERT_FALSE(j.empty());
+  EXPECT_EQ(j.front(), '{');
+  EXPECT_EQ(j[j.find_last_not_of(" \n")], '}');
+  EXPECT_EQ(std::count(j.begin(), j.end(), '{'), std::count(j.begin(), j.end(), '}'));
+  EXPECT_EQ(std::count(j.begin(), j.end(), '['), std::count(j.begin(), j.end(), ']'));
+  EXPECT_EQ(j.find("inf"), std::string::npos);
+  EXPECT_EQ(j.find("nan"), std::string::npos);
+  for (const char* key : {"version", "bytes", "vertexCount", "maxDimension", "simplexCounts",
+                          "quantization", "bits", "axisBits", "bitsPerVertex", "total",
+                          "geometry", "chunks"}) {
+    EXPECT_NE(j.find("\"" + std::string(key) + "\":"), std::string::npos) << key << "\n" << j;
+  }
+  auto number = [&j](const char* key) {
+    const size_t at = j.find("\"" + std::string(key) + "\":");
+    if (at == std::string::npos) return std::nan("");
+    return std::strtod(j.c_str() + at + std::strlen(key) + 3, nullptr);
+  };
+  EXPECT_EQ(number("vertexCount"), 3000.0);
+  EXPECT_EQ(number("bytes"), double(size));
+  EXPECT_EQ(number("bits"), 10.0);
+  EXPECT_NEAR(number("total"), 8.0 * double(size) / 3000.0, 1e-9);
+  EXPECT_GT(number("geometry"), 0.0);
+  EXPECT_LT(number("geometry"), number("total"));
+  EXPECT_NE(j.find("\"quantization\": \"grid\""), std::string::npos);
+
+  runOk("encode cloud.ply -o exact.kdm --exact");
+  const CliRun exact = runOk("info --json exact.kdm");
+  EXPECT_NE(exact.out.find("\"quantization\": \"float32\""), std::string::npos) << exact.out;
+}
+
+TEST_F(CliTest, QuietSuppressesProgressAndStatistics) {
+  writeModel("cloud.xyz", pointCloud(uniformCloud(2000, 35)));
+  const CliRun loud = runOk("encode cloud.xyz -o a.kdm");
+  EXPECT_NE(loud.err.find("2000 vertices"), std::string::npos) << loud.err;
+  for (const char* args : {"-q encode cloud.xyz -o b.kdm", "--quiet encode cloud.xyz -o c.kdm",
+                           "encode -q cloud.xyz -o d.kdm", "encode cloud.xyz -o e.kdm --quiet"}) {
+    const CliRun quiet = runOk(args);
+    EXPECT_EQ(quiet.err, "") << args;
+    EXPECT_EQ(quiet.out, "") << args;
+  }
+  EXPECT_EQ(readBytes(at("a.kdm")), readBytes(at("e.kdm")));
+  const CliRun loudDecode = runOk("decode a.kdm -o a.ply");
+  EXPECT_NE(loudDecode.err.find("2000 vertices"), std::string::npos) << loudDecode.err;
+  EXPECT_EQ(runOk("-q decode a.kdm -o b.ply").err, "");
+  EXPECT_EQ(runOk("decode a.kdm -o c.ply -q").err, "");
+  // Notes about the input are statistics too.
+  writeWhole(at("extra.xyz"), "1 2 3 255 0 0\n4 5 6 0 255 0\n");
+  EXPECT_NE(runOk("encode extra.xyz -o f.kdm").err.find("extra columns"), std::string::npos);
+  EXPECT_EQ(runOk("encode extra.xyz -o f.kdm -q").err, "");
+}
+
+TEST_F(CliTest, MissingMalformedAndUnknownInputsFailWithOneLine) {
+  writeModel("cloud.xyz", pointCloud(uniformCloud(500, 36)));
+  runOk("-q encode cloud.xyz -o good.kdm");
+
+  EXPECT_NE(expectError("encode missing.ply -o x.kdm").find("missing.ply"), std::string::npos);
+  EXPECT_NE(expectError("decode missing.kdm -o x.ply").find("missing.kdm"), std::string::npos);
+  EXPECT_NE(expectError("info missing.kdm").find("missing.kdm"), std::string::npos);
+
+  writeWhole(at("bad.xyz"), "1 2 3\n4 5 six\n");
+  EXPECT_NE(expectError("encode bad.xyz -o x.kdm").find("line 2"), std::string::npos);
+  writeWhole(at("bad.ply"), "ply\nformat ascii 1.0\nelement vertex 99999\nproperty float x\n");
+  expectError("encode bad.ply -o x.kdm");
+  writeWhole(at("empty.obj"), "");
+  expectError("encode empty.obj -o x.kdm");
+  writeWhole(at("nothing.obj"), "# no vertices\n");
+  expectError("encode nothing.obj -o x.kdm");
+  // Read fine, refused by the encoder after its progress line has started.
+  writeWhole(at("nan.xyz"), "1 2 3\n4 nan 6\n");
+  EXPECT_NE(expectError("encode nan.xyz -o x.kdm").find("NaN"), std::string::npos);
+  EXPECT_FALSE(fs::exists(at("x.kdm")));
+
+  fs::copy_file(at("cloud.xyz"), at("cloud.foo"));
+  EXPECT_NE(expectError("encode cloud.foo -o x.kdm").find("cloud.foo"), std::string::npos);
+  EXPECT_NE(expectError("decode good.kdm -o out.foo").find("out.foo"), std::string::npos);
+  EXPECT_FALSE(fs::exists(at("out.foo")));
+  expectError("decode good.kdm -o noextension");
+  expectError("decode cloud.xyz -o out.ply");  // not a kdmesh stream
+  expectError("info cloud.xyz");
+}
+
+TEST_F(CliTest, CorruptedAndTruncatedStreamsFailWithOneLine) {
+  writeModel("cloud.xyz", pointCloud(clusteredCloud(3000, 37)));
+  runOk("-q encode cloud.xyz -o good.kdm --bits 16");
+  const std::vector<uint8_t> good = readBytes(at("good.kdm"));
+  ASSERT_GT(good.size(), 2000u);
+  const size_t positions[] = {0, 10, 40, kHeaderBytes + 2, good.size() / 2, good.size() - 1};
+  for (size_t position : positions) {
+    SCOPED_TRACE("flipped byte " + std::to_string(position));
+    std::vector<uint8_t> bad = good;
+    bad[position] ^= 0x20;
+    writeBytes(at("bad.kdm"), bad);
+    expectError("decode bad.kdm -o bad.ply");
+    expectError("info bad.kdm");
+    expectError("info --json bad.kdm");
+  }
+  for (size_t length : {size_t{0}, size_t{50}, kHeaderBytes, good.size() / 2, good.size() - 1}) {
+    SCOPED_TRACE("truncated to " + std::to_string(length));
+    writeBytes(at("short.kdm"), std::vector<uint8_t>(good.begin(), good.begin() + length));
+    expectError("decode short.kdm -o short.ply");
+    expectError("info short.kdm");
+  }
+  std::vector<uint8_t> longer = good;
+  longer.push_back(0);
+  writeBytes(at("long.kdm"), longer);
+  expectError("decode long.kdm -o long.ply");
+  expectError("info long.kdm");
+}
+
+TEST_F(CliTest, BadOptionsFailWithOneLine) {
+  writeModel("cloud.xyz", pointCloud(uniformCloud(100, 38)));
+  for (const char* args :
+       {"encode cloud.xyz -o x.kdm --bits 0", "encode cloud.xyz -o x.kdm --bits 31",
+        "encode cloud.xyz -o x.kdm --bits -3", "encode cloud.xyz -o x.kdm --bits twelve",
+        "encode cloud.xyz -o x.kdm --bits 12 --exact", "encode cloud.xyz -o x.kdm --exact --bits 12",
+        "encode cloud.xyz", "encode -o x.kdm", "encode cloud.xyz -o x.kdm --chunk-bytes 1",
+        "encode cloud.xyz -o x.kdm --frobnicate", "encode cloud.xyz extra -o x.kdm", "",
+        "compress cloud.xyz"}) {
+    SCOPED_TRACE(args);
+    expectError(args);
+    EXPECT_FALSE(fs::exists(at("x.kdm")));
+  }
+  runOk("-q encode cloud.xyz -o x.kdm --bits 30");
+  runOk("-q encode cloud.xyz -o y.kdm --bits 1");
+  EXPECT_EQ(readModel("cloud.xyz").vertexCount(), 100u);
+}
+
+}  // namespace
+}  // namespace kdmesh::test
