@@ -77,8 +77,8 @@ inline Complex gridWithHoles(int n) {
   }, [](int i, int j) { return (i / 3 + j / 3) % 4 == 1 && i % 3 != 0; });
 }
 
-// Kuhn subdivision of an n^3 block of cubes into 6 positively oriented
-// tetrahedra each: a conforming tetrahedral mesh.
+// Kuhn subdivision of an n^3 block of jittered cubes into 6 tetrahedra each:
+// a conforming tetrahedral mesh.
 inline Complex tetrahedralBlock(int n, uint32_t seed) {
   Complex c;
   std::mt19937 rng(seed);
