@@ -12,6 +12,8 @@
 #include <string>
 #include <vector>
 
+#include <unistd.h>
+
 #include "kdmesh/io.h"
 #include "kdmesh/kdmesh.h"
 
@@ -83,11 +85,12 @@ bool writeBytes(const std::string& path, const std::vector<uint8_t>& bytes, std:
   return true;
 }
 
-// Prints "phase NN%" on one stderr line, at most once per percent.
+// Prints "phase NN%" on one stderr line, at most once per percent, when
+// stderr is a terminal (a log file would collect every update).
 class ProgressLine {
  public:
   void update(const char* phase, double fraction) {
-    if (gQuiet) return;
+    if (gQuiet || !terminal_) return;
     const int percent = int(fraction * 100);
     if (phase == phase_ && percent == percent_) return;
     phase_ = phase;
@@ -98,9 +101,25 @@ class ProgressLine {
   ~ProgressLine() { clearProgress(); }
 
  private:
+  const bool terminal_ = isatty(fileno(stderr)) != 0;
   const char* phase_ = nullptr;
   int percent_ = -1;
 };
+
+// One note per kind of input simplex the encoder dropped (see InputRepairs).
+void reportRepairs(const std::string& input, const kdmesh::InputRepairs& repairs) {
+  static const char* const kNames[4] = {"points", "edges", "triangles", "tetrahedra"};
+  for (int d = 0; d < 4; ++d) {
+    const auto count = [&](uint64_t value, const char* why) {
+      if (value > 0)
+        note(input + ": dropped " + std::to_string(value) + " " + kNames[d] + " " + why);
+    };
+    count(repairs.degenerate[size_t(d)], "with a repeated vertex");
+    count(repairs.duplicate[size_t(d)], "listed twice");
+    count(repairs.redundant[size_t(d)],
+          d == 0 ? "on vertices of other simplices (implied)" : "that are faces of other listed simplices (implied)");
+  }
+}
 
 struct EncodeArgs {
   std::string input, output;
@@ -138,13 +157,16 @@ int runEncode(const EncodeArgs& args) {
   if (!result.status.ok()) return fail(result.status, "cannot encode " + args.input);
   std::string error;
   if (!writeBytes(args.output, result.bytes, error)) return fail(error);
+  reportRepairs(args.input, result.repairs);
   if (!gQuiet) {
     const double n = double(complex.vertexCount());
     std::fprintf(stderr,
-                 "%s: %zu vertices -> %zu bytes, %.3f bits/vertex (geometry %.3f) "
-                 "[read %.3fs, encode %.3fs]\n",
-                 args.output.c_str(), complex.vertexCount(), result.bytes.size(),
-                 8.0 * double(result.bytes.size()) / n, result.cost.geometryBits / n, readSeconds,
+                 "%s: %zu vertices, %zu simplices -> %zu bytes, %.3f bits/vertex (connectivity %.3f, "
+                 "geometry %.3f) [read %.3fs, encode %.3fs]\n",
+                 args.output.c_str(), complex.vertexCount(),
+                 complex.simplexCount(1) + complex.simplexCount(2) + complex.simplexCount(3),
+                 result.bytes.size(), 8.0 * double(result.bytes.size()) / n,
+                 result.cost.connectivityBits / n, result.cost.geometryBits / n, readSeconds,
                  encodeSeconds);
   }
   return 0;
@@ -197,6 +219,7 @@ int runInfo(const std::string& input, bool json) {
   const kdmesh::Header& h = decoder.header();
   const double n = h.vertexCount;
   const kdmesh::CodingCost cost = decoder.cost();
+  const kdmesh::ConnectivityStatistics stats = decoder.statistics();
   const bool grid = h.quantization == kdmesh::Quantization::Grid;
   if (json) {
     std::printf("{\n  \"version\": %u,\n  \"bytes\": %zu,\n  \"vertexCount\": %u,\n",
@@ -215,6 +238,14 @@ int runInfo(const std::string& input, bool json) {
                 jsonNumber(8.0 * double(bytes.size()) / n).c_str(),
                 jsonNumber(cost.geometryBits / n).c_str(),
                 jsonNumber(cost.connectivityBits / n).c_str());
+    std::printf("  \"operators\": {\"vertexSplits\": %" PRIu64 ", \"edgeExpansions\": 0, "
+                "\"codes\": [",
+                stats.vertexSplits);
+    for (int d = 0; d < 4; ++d)
+      std::printf("%s[%" PRIu64 ", %" PRIu64 ", %" PRIu64 ", %" PRIu64 "]", d ? ", " : "", stats.codes[d][0],
+                  stats.codes[d][1], stats.codes[d][2], stats.codes[d][3]);
+    std::printf("], \"orientationBits\": %" PRIu64 ", \"orientationMispredicted\": %" PRIu64 "},\n",
+                stats.orientationBits, stats.orientationMispredicted);
     std::printf("  \"chunks\": [");
     const auto& chunks = decoder.chunks();
     for (size_t i = 0; i < chunks.size(); ++i)
@@ -239,6 +270,21 @@ int runInfo(const std::string& input, bool json) {
   std::printf("bits/vertex     %.3f total: %.3f geometry, %.3f connectivity, %.3f container\n",
               8.0 * double(bytes.size()) / n, cost.geometryBits / n, cost.connectivityBits / n,
               (8.0 * double(bytes.size()) - cost.geometryBits - cost.connectivityBits) / n);
+  if (h.maxDimension > 0) {
+    // As the paper's Table 1: which operator undid each of the n - 1 merges.
+    std::printf("operators       %" PRIu64 " vertex splits (%.1f %% of %u merges), 0 edge expansions\n",
+                stats.vertexSplits, n > 1 ? 100.0 * double(stats.vertexSplits) / (n - 1) : 0.0,
+                h.vertexCount - 1);
+    static const char* const kNames[4] = {"vertex", "edge", "triangle", "tetrahedron"};
+    for (int d = 0; d < 4; ++d) {
+      const auto& c = stats.codes[size_t(d)];
+      if (c[0] + c[1] + c[2] + c[3] == 0) continue;
+      std::printf("  %-11s   codes 1/2/3/4: %" PRIu64 " / %" PRIu64 " / %" PRIu64 " / %" PRIu64 "\n",
+                  kNames[d], c[0], c[1], c[2], c[3]);
+    }
+    std::printf("  orientation   %" PRIu64 " decisions, %" PRIu64 " mispredicted\n", stats.orientationBits,
+                stats.orientationMispredicted);
+  }
   std::printf("chunks          %zu\n", decoder.chunks().size());
   std::printf("  %5s %10s %8s %10s\n", "chunk", "offset", "payload", "splits");
   for (size_t i = 0; i < decoder.chunks().size(); ++i) {
