@@ -93,7 +93,14 @@ struct Decoder::State {
     if (connectivity) {
       store.reset(header.vertexCount, false);
       const std::array<uint64_t, 4> caps = simplexCaps(header);
-      for (int d = 1; d <= 3; ++d) store.setCapacity(d, uint32_t(std::min<uint64_t>(caps[size_t(d)], 0xffffffffu)));
+      // Reserve what the header promises, but no more than a generous
+      // multiple of the bytes that could describe it, so that a hostile
+      // header cannot make the decoder reserve gigabytes up front.
+      const uint64_t plausible = 64 * header.bodyBytes + 1024;
+      for (int d = 1; d <= 3; ++d) {
+        const uint32_t cap = uint32_t(std::min<uint64_t>(caps[size_t(d)], 0xffffffffu));
+        store.setCapacity(d, cap, uint32_t(std::min<uint64_t>(cap, plausible)));
+      }
       splitter.emplace(store);
     }
     hasHeader = true;

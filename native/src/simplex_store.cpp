@@ -29,8 +29,13 @@ void SimplexStore::reset(uint32_t vertexCapacity, bool indexed) {
   }
 }
 
-void SimplexStore::setCapacity(int dimension, uint32_t maxSimplices) {
-  pool_[dimension].capacity = maxSimplices;
+void SimplexStore::setCapacity(int dimension, uint32_t maxSimplices, uint32_t expected) {
+  Pool& pool = pool_[dimension];
+  pool.capacity = maxSimplices;
+  expected = std::min(expected, maxSimplices);
+  pool.vertices.reserve(size_t(expected) * size_t(dimension + 1));
+  pool.next.reserve(size_t(expected) * size_t(dimension + 1));
+  pool.flags.reserve(expected);
 }
 
 uint64_t SimplexStore::hashOf(int dimension, const uint32_t* vertices) {

@@ -40,8 +40,9 @@ class SimplexStore {
   // memory.
   void reset(uint32_t vertexCapacity, bool indexed);
   uint32_t vertexCapacity() const { return uint32_t(heads_[1].size()); }
-  // Pool sizes (live and killed) may not exceed these; add() reports false.
-  void setCapacity(int dimension, uint32_t maxSimplices);
+  // Pool sizes (live and killed) may not exceed `maxSimplices`; add()
+  // reports kNoSimplex. Memory for `expected` simplices is reserved at once.
+  void setCapacity(int dimension, uint32_t maxSimplices, uint32_t expected);
 
   // Adds a simplex whose vertices are all distinct and that is not yet
   // present; links it into its vertices' lists. Returns its index, or

@@ -79,8 +79,7 @@ uint8_t VertexSplitter::possibleCodes(const Entry& entry) const {
   return possible;
 }
 
-int VertexSplitter::predictFlip(int dimension, uint32_t simplex, uint32_t v, uint32_t v2,
-                                int& voteClass) {
+int VertexSplitter::predictFlip(int dimension, uint32_t simplex, int& voteClass) {
   const int arity = dimension + 1;
   const uint32_t* mine = store_.vertices(dimension, simplex);
   const int myParity = store_.parity(dimension, simplex);
@@ -109,10 +108,7 @@ int VertexSplitter::predictFlip(int dimension, uint32_t simplex, uint32_t v, uin
     else
       ++keep;
   };
-  store_.forEachIncident(dimension, v, [&](uint32_t other, uint32_t) { consider(other); });
-  store_.forEachIncident(dimension, v2, [&](uint32_t other, uint32_t) {
-    if (!containsVertex(store_.vertices(dimension, other), arity, v)) consider(other);
-  });
+  for (const uint32_t other : around_[size_t(dimension)]) consider(other);
   voteClass = keep + flip == 0 ? 0 : (keep == 0 || flip == 0) ? 1 : 2;
   return flip > keep;
 }

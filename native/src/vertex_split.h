@@ -84,13 +84,13 @@ class VertexSplitter {
   template <class Coder>
   uint8_t codeSymbol(Coder& coder, int dimension, uint8_t possible, uint8_t code);
   template <class Coder>
-  void decideOrientation(Coder& coder, int dimension, uint32_t simplex, uint32_t v, uint32_t v2,
-                         bool isCopy, uint8_t target);
-  int predictFlip(int dimension, uint32_t simplex, uint32_t v, uint32_t v2, int& voteClass);
+  void decideOrientation(Coder& coder, int dimension, uint32_t simplex, bool isCopy, uint8_t target);
+  int predictFlip(int dimension, uint32_t simplex, int& voteClass);
 
   SimplexStore& store_;
   std::vector<Entry> star_;
   std::array<size_t, 5> begin_{};  // star_ entries of dimension d: [begin_[d], begin_[d+1])
+  std::array<std::vector<uint32_t>, 4> around_;  // simplices of dimension d at v or v2
   // Code models: [dimension][possible set][step of the sequential binarisation].
   BitModel codeModels_[4][16][3];
   // Orientation models: [dimension - 2][copy or new][vote class][face of higher].
@@ -111,10 +111,10 @@ uint8_t VertexSplitter::codeSymbol(Coder& coder, int dimension, uint8_t possible
 }
 
 template <class Coder>
-void VertexSplitter::decideOrientation(Coder& coder, int dimension, uint32_t simplex, uint32_t v,
-                                       uint32_t v2, bool isCopy, uint8_t target) {
+void VertexSplitter::decideOrientation(Coder& coder, int dimension, uint32_t simplex, bool isCopy,
+                                       uint8_t target) {
   int voteClass = 0;
-  const int predicted = predictFlip(dimension, simplex, v, v2, voteClass);
+  const int predicted = predictFlip(dimension, simplex, voteClass);
   const int faceOfHigher = store_.isFace(dimension, simplex);
   int flip = predicted;
   if (target != split_record::kFree)
@@ -168,13 +168,28 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, Oracle&& oracl
     }
   }
 
+  // After the split, the simplices around v and v2 are exactly the star's
+  // simplices and their copies and additions: the neighbours that orient
+  // the new ones are found there without walking the vertex lists.
+  for (int d = 2; d <= SimplexStore::kMaxDimension; ++d) {
+    around_[size_t(d)].clear();
+    for (size_t i = begin_[size_t(d) - 1]; i < begin_[size_t(d) + 1]; ++i) {
+      const Entry& entry = star_[i];
+      if (entry.dimension == d) {
+        around_[size_t(d)].push_back(entry.simplex);
+        if (entry.copy != kNoSimplex) around_[size_t(d)].push_back(entry.copy);
+      } else if (entry.added != kNoSimplex) {
+        around_[size_t(d)].push_back(entry.added);
+      }
+    }
+  }
   for (const Entry& entry : star_) {
     const int d = entry.dimension;
     if (entry.copy != kNoSimplex && d >= 2)
-      decideOrientation(coder, d, entry.copy, v, v2, true,
+      decideOrientation(coder, d, entry.copy, true,
                         uint8_t((entry.record >> split_record::kCopyTargetShift) & 3));
     if (entry.added != kNoSimplex && d + 1 >= 2)
-      decideOrientation(coder, d + 1, entry.added, v, v2, false,
+      decideOrientation(coder, d + 1, entry.added, false,
                         uint8_t((entry.record >> split_record::kNewTargetShift) & 3));
   }
   return true;

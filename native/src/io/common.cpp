@@ -175,6 +175,17 @@ std::string quoted(std::string_view token) {
   return "'" + std::string(token) + "'";
 }
 
+bool equalsIgnoringCase(std::string_view a, std::string_view b) {
+  if (a.size() != b.size()) return false;
+  for (size_t i = 0; i < a.size(); ++i) {
+    char x = a[i], y = b[i];
+    if (x >= 'A' && x <= 'Z') x = static_cast<char>(x - 'A' + 'a');
+    if (y >= 'A' && y <= 'Z') y = static_cast<char>(y - 'A' + 'a');
+    if (x != y) return false;
+  }
+  return true;
+}
+
 Status inputError(std::string message) {
   return Status::error(ErrorCode::InvalidInput, std::move(message));
 }

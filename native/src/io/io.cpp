@@ -75,27 +75,151 @@ Status unknownFormat(const std::string& path) {
   return Status::error(ErrorCode::InvalidArgument,
                        "cannot tell the format of " + path +
                            " from its extension (expected .ply, .obj, "
-                           ".off, .xyz, .txt or .pts)");
+                           ".off, .xyz, .txt, .pts, .stl, .mesh, .node, .ele "
+                           "or .vtk)");
 }
 
-}  // namespace
-
-Format formatFromPath(const std::string& path) {
+// The extension after the last dot of the file name, lower-cased; empty when
+// there is none.
+std::string extensionOf(const std::string& path) {
   const size_t dot = path.find_last_of('.');
   const size_t slash = path.find_last_of("/\\");
   if (dot == std::string::npos || (slash != std::string::npos && dot < slash)) {
-    return Format::Unknown;
+    return std::string();
   }
   std::string extension = path.substr(dot + 1);
   for (char& c : extension) {
     if (c >= 'A' && c <= 'Z') c = static_cast<char>(c - 'A' + 'a');
   }
+  return extension;
+}
+
+// Reads a whole file. `missing` tells whether it failed because the file
+// does not exist.
+Status readWholeFile(const std::string& path, std::vector<uint8_t>& bytes,
+                     bool* missing = nullptr) {
+  FilePtr file(std::fopen(path.c_str(), "rb"));
+  if (!file) {
+    if (missing) *missing = errno == ENOENT;
+    return fileError("cannot open", path);
+  }
+  // Read in growing blocks rather than trusting a size from fseek/ftell, which
+  // pipes and special files do not give.
+  size_t used = 0;
+  for (size_t block = 1 << 16;; block = std::min<size_t>(block * 2, 1 << 26)) {
+    bytes.resize(used + block);
+    const size_t got = std::fread(bytes.data() + used, 1, block, file.get());
+    used += got;
+    if (got < block) break;
+  }
+  if (std::ferror(file.get())) return fileError("cannot read", path);
+  bytes.resize(used);
+  return Status::success();
+}
+
+Status writeWholeFile(const std::string& path,
+                      const std::vector<uint8_t>& bytes) {
+  FilePtr file(std::fopen(path.c_str(), "wb"));
+  if (!file) return fileError("cannot open", path);
+  const size_t written = std::fwrite(bytes.data(), 1, bytes.size(), file.get());
+  // fclose flushes, so its result decides whether the bytes reached the file.
+  if (written != bytes.size() || std::fclose(file.release()) != 0) {
+    return fileError("cannot write", path);
+  }
+  return Status::success();
+}
+
+// x.node and x.ele beside a path that names either, with the extension in
+// the case of the one given.
+struct TetgenPaths {
+  std::string node, ele;
+  bool givenEle = false;
+};
+
+TetgenPaths tetgenPaths(const std::string& path) {
+  const size_t dot = path.find_last_of('.');
+  const std::string stem = path.substr(0, dot);
+  const bool upper = dot + 1 < path.size() && path[dot + 1] >= 'A' &&
+                     path[dot + 1] <= 'Z';
+  TetgenPaths paths;
+  paths.node = stem + (upper ? ".NODE" : ".node");
+  paths.ele = stem + (upper ? ".ELE" : ".ele");
+  paths.givenEle = extensionOf(path) == "ele";
+  return paths;
+}
+
+// An error in the file the user did not name says which file it is in.
+Status inFile(Status status, const std::string& file,
+              const std::string& given) {
+  if (!status.ok() && file != given) {
+    status.message = file + ": " + status.message;
+  }
+  return status;
+}
+
+Status readTetgenFiles(const std::string& path, Complex& out, Notes& notes) {
+  const TetgenPaths paths = tetgenPaths(path);
+  std::vector<uint8_t> bytes;
+  if (Status status = readWholeFile(paths.node, bytes); !status.ok()) {
+    return status;
+  }
+  if (isBlank(bytes.data(), bytes.size())) {
+    return inFile(inputError("file is empty"), paths.node, path);
+  }
+  uint32_t firstIndex = 0;
+  Status status =
+      detail::readTetgenNode(bytes.data(), bytes.size(), out, notes, firstIndex);
+  if (!status.ok()) return inFile(status, paths.node, path);
+
+  bool missing = false;
+  bytes.clear();
+  status = readWholeFile(paths.ele, bytes, &missing);
+  if (!status.ok()) {
+    if (!missing || paths.givenEle) return status;
+    notes.push_back("no " + paths.ele + ": read the nodes as a point cloud");
+    return Status::success();
+  }
+  if (isBlank(bytes.data(), bytes.size())) {
+    return inFile(inputError("file is empty"), paths.ele, path);
+  }
+  status = detail::readTetgenEle(bytes.data(), bytes.size(), firstIndex, out,
+                                 notes);
+  return inFile(status, paths.ele, path);
+}
+
+Status writeTetgenFiles(const std::string& path, const Complex& complex) {
+  if (Status status = checkWritable(complex); !status.ok()) return status;
+  const TetgenPaths paths = tetgenPaths(path);
+  std::vector<uint8_t> node, ele;
+  if (Status status = detail::writeTetgenNode(complex, node); !status.ok()) {
+    return status;
+  }
+  const bool writeEle = !complex.tetrahedra.empty() || paths.givenEle;
+  if (writeEle) {
+    if (Status status = detail::writeTetgenEle(complex, ele); !status.ok()) {
+      return status;
+    }
+  }
+  if (Status status = writeWholeFile(paths.node, node); !status.ok()) {
+    return status;
+  }
+  return writeEle ? writeWholeFile(paths.ele, ele) : Status::success();
+}
+
+}  // namespace
+
+Format formatFromPath(const std::string& path) {
+  const std::string extension = extensionOf(path);
   if (extension == "ply") return Format::Ply;
   if (extension == "obj") return Format::Obj;
   if (extension == "off") return Format::Off;
   if (extension == "xyz" || extension == "txt" || extension == "pts") {
     return Format::Xyz;
   }
+  if (extension == "stl") return Format::Stl;
+  if (extension == "mesh") return Format::Medit;
+  if (extension == "node" || extension == "ele") return Format::TetGen;
+  if (extension == "vtk") return Format::Vtk;
   return Format::Unknown;
 }
 
@@ -105,13 +229,17 @@ const char* formatName(Format format) {
     case Format::Obj: return "obj";
     case Format::Off: return "off";
     case Format::Xyz: return "xyz";
+    case Format::Stl: return "stl";
+    case Format::Medit: return "medit";
+    case Format::TetGen: return "tetgen";
+    case Format::Vtk: return "vtk";
     case Format::Unknown: break;
   }
   return "unknown";
 }
 
 Status readMemory(Format format, const uint8_t* data, size_t size,
-                  Complex& out, Notes& notes) {
+                  Complex& out, Notes& notes, const ReadOptions& options) {
   out = Complex{};
   if (format == Format::Unknown) {
     return Status::error(ErrorCode::InvalidArgument, "unknown file format");
@@ -123,31 +251,43 @@ Status readMemory(Format format, const uint8_t* data, size_t size,
     case Format::Obj: status = detail::readObj(data, size, out, notes); break;
     case Format::Off: status = detail::readOff(data, size, out, notes); break;
     case Format::Xyz: status = detail::readXyz(data, size, out, notes); break;
+    case Format::Stl: status = detail::readStl(data, size, out, notes); break;
+    case Format::Medit:
+      status = detail::readMedit(data, size, out, notes);
+      break;
+    case Format::Vtk: status = detail::readVtk(data, size, out, notes); break;
+    case Format::TetGen: {  // one buffer: the .node file alone
+      uint32_t firstIndex = 0;
+      status = detail::readTetgenNode(data, size, out, notes, firstIndex);
+      break;
+    }
     case Format::Unknown: break;
   }
-  if (!status.ok()) out = Complex{};
+  if (!status.ok()) {
+    out = Complex{};
+  } else if (options.weld) {
+    detail::weldVertices(out, notes);
+  }
   return status;
 }
 
-Status readFile(const std::string& path, Complex& out, Notes& notes) {
+Status readFile(const std::string& path, Complex& out, Notes& notes,
+                const ReadOptions& options) {
   const Format format = formatFromPath(path);
   if (format == Format::Unknown) return unknownFormat(path);
-  FilePtr file(std::fopen(path.c_str(), "rb"));
-  if (!file) return fileError("cannot open", path);
-
-  // Read in growing blocks rather than trusting a size from fseek/ftell, which
-  // pipes and special files do not give.
-  std::vector<uint8_t> bytes;
-  size_t used = 0;
-  for (size_t block = 1 << 16;; block = std::min<size_t>(block * 2, 1 << 26)) {
-    bytes.resize(used + block);
-    const size_t got = std::fread(bytes.data() + used, 1, block, file.get());
-    used += got;
-    if (got < block) break;
+  if (format == Format::TetGen) {
+    out = Complex{};
+    Status status = readTetgenFiles(path, out, notes);
+    if (!status.ok()) {
+      out = Complex{};
+    } else if (options.weld) {
+      detail::weldVertices(out, notes);
+    }
+    return status;
   }
-  if (std::ferror(file.get())) return fileError("cannot read", path);
-  bytes.resize(used);
-  return readMemory(format, bytes.data(), bytes.size(), out, notes);
+  std::vector<uint8_t> bytes;
+  if (Status status = readWholeFile(path, bytes); !status.ok()) return status;
+  return readMemory(format, bytes.data(), bytes.size(), out, notes, options);
 }
 
 Status writeMemory(Format format, const Complex& complex,
@@ -156,6 +296,10 @@ Status writeMemory(Format format, const Complex& complex,
   if (format == Format::Unknown) {
     return Status::error(ErrorCode::InvalidArgument, "unknown file format");
   }
+  if (format == Format::Stl) {
+    return Status::error(ErrorCode::InvalidArgument,
+                         "writing STL is not supported");
+  }
   if (Status status = checkWritable(complex); !status.ok()) return status;
   Status status;
   switch (format) {
@@ -163,7 +307,19 @@ Status writeMemory(Format format, const Complex& complex,
     case Format::Obj: status = detail::writeObj(complex, out); break;
     case Format::Off: status = detail::writeOff(complex, out); break;
     case Format::Xyz: status = detail::writeXyz(complex, out); break;
-    case Format::Unknown: break;
+    case Format::Medit: status = detail::writeMedit(complex, out); break;
+    case Format::Vtk: status = detail::writeVtk(complex, out); break;
+    case Format::TetGen:
+      if (!complex.tetrahedra.empty()) {
+        status = Status::error(
+            ErrorCode::InvalidArgument,
+            "writeMemory gives only the TetGen .node file, which cannot hold "
+            "tetrahedra; writeFile writes the .ele file beside it");
+      } else {
+        status = detail::writeTetgenNode(complex, out);
+      }
+      break;
+    case Format::Stl: case Format::Unknown: break;
   }
   if (!status.ok()) out.clear();
   return status;
@@ -173,19 +329,13 @@ Status writeFile(const std::string& path, const Complex& complex,
                  const WriteOptions& options) {
   const Format format = formatFromPath(path);
   if (format == Format::Unknown) return unknownFormat(path);
+  if (format == Format::TetGen) return writeTetgenFiles(path, complex);
   std::vector<uint8_t> bytes;
   if (Status status = writeMemory(format, complex, bytes, options);
       !status.ok()) {
     return status;
   }
-  FilePtr file(std::fopen(path.c_str(), "wb"));
-  if (!file) return fileError("cannot open", path);
-  const size_t written = std::fwrite(bytes.data(), 1, bytes.size(), file.get());
-  // fclose flushes, so its result decides whether the bytes reached the file.
-  if (written != bytes.size() || std::fclose(file.release()) != 0) {
-    return fileError("cannot write", path);
-  }
-  return Status::success();
+  return writeWholeFile(path, bytes);
 }
 
 namespace detail {

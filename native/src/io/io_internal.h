@@ -74,6 +74,10 @@ Status readPositionLine(TextScanner& scanner, std::vector<float>& positions,
 // `what` for an error message: the token in quotes, shortened if long.
 std::string quoted(std::string_view token);
 
+// ASCII letters compared without regard to case (keywords of STL, Medit and
+// VTK files are written in either).
+bool equalsIgnoringCase(std::string_view a, std::string_view b);
+
 Status inputError(std::string message);
 Status lineError(size_t line, const std::string& message);
 
@@ -133,6 +137,20 @@ Status readPly(const uint8_t* data, size_t size, Complex& out, Notes& notes);
 Status readObj(const uint8_t* data, size_t size, Complex& out, Notes& notes);
 Status readOff(const uint8_t* data, size_t size, Complex& out, Notes& notes);
 Status readXyz(const uint8_t* data, size_t size, Complex& out, Notes& notes);
+Status readStl(const uint8_t* data, size_t size, Complex& out, Notes& notes);
+Status readMedit(const uint8_t* data, size_t size, Complex& out, Notes& notes);
+Status readVtk(const uint8_t* data, size_t size, Complex& out, Notes& notes);
+// A TetGen .node file; `firstIndex` receives the number of its first point
+// (0 or 1), which the .ele file counts from too.
+Status readTetgenNode(const uint8_t* data, size_t size, Complex& out,
+                      Notes& notes, uint32_t& firstIndex);
+// A TetGen .ele file whose nodes are the `out.vertexCount()` vertices already
+// read, numbered from `firstIndex`.
+Status readTetgenEle(const uint8_t* data, size_t size, uint32_t firstIndex,
+                     Complex& out, Notes& notes);
+
+// Merges vertices with bit-identical positions (ReadOptions::weld).
+void weldVertices(Complex& complex, Notes& notes);
 
 // Writers receive a complex whose array sizes and indices are valid.
 Status writePly(const Complex& complex, std::vector<uint8_t>& out,
@@ -140,6 +158,12 @@ Status writePly(const Complex& complex, std::vector<uint8_t>& out,
 Status writeObj(const Complex& complex, std::vector<uint8_t>& out);
 Status writeOff(const Complex& complex, std::vector<uint8_t>& out);
 Status writeXyz(const Complex& complex, std::vector<uint8_t>& out);
+Status writeMedit(const Complex& complex, std::vector<uint8_t>& out);
+Status writeVtk(const Complex& complex, std::vector<uint8_t>& out);
+// The .node file, after checking that the complex has nothing but vertices
+// and tetrahedra; the .ele file (which may list no tetrahedra).
+Status writeTetgenNode(const Complex& complex, std::vector<uint8_t>& out);
+Status writeTetgenEle(const Complex& complex, std::vector<uint8_t>& out);
 
 // True when every listed point is a vertex used by no simplex, so a format
 // without explicit points loses nothing by dropping the list: such vertices

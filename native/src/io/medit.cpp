@@ -1,0 +1,385 @@
+// INRIA Medit .mesh, ascii: keywords, each followed by a count and that many
+// items, with 1-based vertex indices and a reference label closing each item:
+//
+//   MeshVersionFormatted 1
+//   Dimension 3
+//   Vertices  n   then n lines "x y z ref"
+//   Edges     n   then "a b ref"
+//   Triangles n   then "a b c ref"
+//   Tetrahedra n  then "a b c d ref"
+//   End
+//
+// Values are read as a token stream, so counts and items may wrap over lines;
+// '#' starts a comment. Quadrilaterals become two triangles each (noted).
+// Sections whose item size is known but which hold no simplices (hexahedra,
+// prisms, corners, normals, ...) are skipped with a note; any other keyword
+// is an error, since there is no telling how much of the file it takes.
+#include <limits>
+
+#include "io/io_internal.h"
+
+namespace kdmesh::io::detail {
+namespace {
+
+enum class Kind : uint8_t {
+  Vertices, Edges, Triangles, Quadrilaterals, Tetrahedra, Skipped
+};
+
+struct Section {
+  std::string_view keyword;
+  Kind kind;
+  uint64_t valuesPerItem;  // including the reference label, if any
+};
+
+constexpr Section kSections[] = {
+    {"Vertices", Kind::Vertices, 4},
+    {"Edges", Kind::Edges, 3},
+    {"Triangles", Kind::Triangles, 4},
+    {"Quadrilaterals", Kind::Quadrilaterals, 5},
+    {"Tetrahedra", Kind::Tetrahedra, 5},
+    // Cells that are not simplices, and higher-order elements.
+    {"Hexahedra", Kind::Skipped, 9},
+    {"Prisms", Kind::Skipped, 7},
+    {"Pyramids", Kind::Skipped, 6},
+    {"EdgesP2", Kind::Skipped, 4},
+    {"TrianglesP2", Kind::Skipped, 7},
+    {"QuadrilateralsQ2", Kind::Skipped, 10},
+    {"TetrahedraP2", Kind::Skipped, 11},
+    {"HexahedraQ2", Kind::Skipped, 28},
+    // Attributes of vertices and elements.
+    {"Corners", Kind::Skipped, 1},
+    {"Ridges", Kind::Skipped, 1},
+    {"RequiredVertices", Kind::Skipped, 1},
+    {"RequiredEdges", Kind::Skipped, 1},
+    {"RequiredTriangles", Kind::Skipped, 1},
+    {"RequiredQuadrilaterals", Kind::Skipped, 1},
+    {"RequiredTetrahedra", Kind::Skipped, 1},
+    {"Normals", Kind::Skipped, 3},
+    {"Tangents", Kind::Skipped, 3},
+    {"NormalAtVertices", Kind::Skipped, 2},
+    {"NormalAtTriangleVertices", Kind::Skipped, 3},
+    {"NormalAtQuadrilateralVertices", Kind::Skipped, 3},
+    {"TangentAtEdgeVertices", Kind::Skipped, 3},
+};
+
+const Section* findSection(std::string_view keyword) {
+  for (const Section& section : kSections) {
+    if (equalsIgnoringCase(section.keyword, keyword)) return &section;
+  }
+  return nullptr;
+}
+
+const char* itemName(Kind kind) {
+  switch (kind) {
+    case Kind::Vertices: return "vertex";
+    case Kind::Edges: return "edge";
+    case Kind::Triangles: return "triangle";
+    case Kind::Quadrilaterals: return "quadrilateral";
+    case Kind::Tetrahedra: return "tetrahedron";
+    case Kind::Skipped: break;
+  }
+  return "item";
+}
+
+size_t arity(Kind kind) {
+  switch (kind) {
+    case Kind::Edges: return 2;
+    case Kind::Triangles: return 3;
+    case Kind::Quadrilaterals: return 4;
+    case Kind::Tetrahedra: return 4;
+    case Kind::Vertices: case Kind::Skipped: break;
+  }
+  return 0;
+}
+
+class MeditReader {
+ public:
+  MeditReader(const uint8_t* data, size_t size, Complex& out)
+      : scanner_(data, size, {/*commaSeparates=*/false,
+                              /*hashComments=*/true}),
+        out_(out) {}
+
+  Status read(Notes& notes) {
+    std::string_view keyword;
+    bool ended = false;
+    while (!ended && scanner_.nextTokenAcrossLines(keyword)) {
+      Status status;
+      if (equalsIgnoringCase(keyword, "End")) {
+        ended = true;
+      } else if (equalsIgnoringCase(keyword, "MeshVersionFormatted")) {
+        status = readVersion();
+      } else if (equalsIgnoringCase(keyword, "Dimension")) {
+        status = readDimension();
+      } else if (const Section* section = findSection(keyword)) {
+        status = readSection(*section);
+      } else {
+        status = error("unknown Medit keyword " + quoted(keyword) +
+                       ": cannot tell how much of the file it takes");
+      }
+      if (!status.ok()) return status;
+    }
+    if (!sawVersion_) {
+      return inputError("not a Medit file: no MeshVersionFormatted keyword");
+    }
+    std::string_view token;
+    if (ended && scanner_.nextTokenAcrossLines(token)) {
+      notes.push_back("ignored what follows End (from line " +
+                      std::to_string(scanner_.lineNumber()) + ")");
+    }
+    if (doublePrecision_) {
+      notes.push_back(
+          "coordinates of MeshVersionFormatted 2 (double precision) were "
+          "rounded to float32");
+    }
+    split_.addNote(notes);
+    addCountNote(notes, "ignored the nonzero references of ", labelled_,
+                 " vertices and elements");
+    for (const std::string& skipped : skipped_) notes.push_back(skipped);
+    return Status::success();
+  }
+
+ private:
+  Status error(const std::string& message) const {
+    return lineError(scanner_.lineNumber(), message);
+  }
+
+  // The value after a keyword, which may be on the next line.
+  Status keywordValue(std::string_view keyword, std::string_view& token) {
+    if (!scanner_.nextTokenAcrossLines(token)) {
+      return error("the file ends after " + std::string(keyword));
+    }
+    return Status::success();
+  }
+
+  Status readVersion() {
+    std::string_view token;
+    if (Status status = keywordValue("MeshVersionFormatted", token);
+        !status.ok()) {
+      return status;
+    }
+    int64_t version = 0;
+    if (!parseInteger(token, version) || version < 1 || version > 4) {
+      return error("MeshVersionFormatted " + quoted(token) +
+                   " is not a version from 1 to 4");
+    }
+    sawVersion_ = true;
+    doublePrecision_ = version >= 2;
+    return Status::success();
+  }
+
+  Status readDimension() {
+    std::string_view token;
+    if (Status status = keywordValue("Dimension", token); !status.ok()) {
+      return status;
+    }
+    int64_t dimension = 0;
+    if (!parseInteger(token, dimension)) {
+      return error("Dimension " + quoted(token) + " is not a number");
+    }
+    if (dimension != 3) {
+      return error("Dimension " + std::to_string(dimension) +
+                   " meshes are not supported, only Dimension 3");
+    }
+    return Status::success();
+  }
+
+  Status readSection(const Section& section) {
+    if (!sawVersion_) {
+      return error("not a Medit file: " + std::string(section.keyword) +
+                   " comes before MeshVersionFormatted");
+    }
+    std::string_view token;
+    if (Status status = keywordValue(section.keyword, token); !status.ok()) {
+      return status;
+    }
+    uint64_t count = 0;
+    if (!parseCount(token, count)) {
+      return error(std::string(section.keyword) + " count " + quoted(token) +
+                   " is not a count");
+    }
+    // Every value takes at least a digit and a separator.
+    uint64_t budget = scanner_.remainingBytes() + 1;
+    if (!takeFromBudget(count, 2 * section.valuesPerItem, budget)) {
+      return error(std::string(section.keyword) + " declares " +
+                   std::to_string(count) +
+                   " items, more than the rest of the file can hold");
+    }
+    switch (section.kind) {
+      case Kind::Vertices: return readVertices(count);
+      case Kind::Skipped: return skipItems(section, count);
+      default: return readElements(section.kind, count);
+    }
+  }
+
+  Status readVertices(uint64_t count) {
+    if (sawVertices_) return error("a second Vertices section");
+    sawVertices_ = true;
+    if (count > std::numeric_limits<uint32_t>::max()) {
+      return error("more vertices than 32-bit indices can address");
+    }
+    out_.positions.reserve(3 * count);
+    for (uint64_t v = 0; v < count; ++v) {
+      float xyz[3];
+      for (float& value : xyz) {
+        std::string_view token;
+        if (Status status = nextValue(Kind::Vertices, v, token); !status.ok()) {
+          return status;
+        }
+        if (!parseFloat(token, value)) {
+          return error("vertex " + std::to_string(v) + ": " + quoted(token) +
+                       " is not a number");
+        }
+      }
+      if (Status status = readReference(Kind::Vertices, v); !status.ok()) {
+        return status;
+      }
+      out_.positions.insert(out_.positions.end(), xyz, xyz + 3);
+    }
+    return Status::success();
+  }
+
+  Status readElements(Kind kind, uint64_t count) {
+    if (count > 0 && !sawVertices_) {
+      return error(std::string(itemName(kind)) +
+                   "s come before the Vertices they refer to");
+    }
+    const size_t size = arity(kind);
+    std::vector<uint32_t>& target =
+        kind == Kind::Edges        ? out_.edges
+        : kind == Kind::Tetrahedra ? out_.tetrahedra
+                                   : out_.triangles;
+    target.reserve(target.size() +
+                   (kind == Kind::Quadrilaterals ? 6 : size) * count);
+    const uint64_t vertexCount = out_.vertexCount();
+    uint32_t corners[4];
+    for (uint64_t item = 0; item < count; ++item) {
+      for (size_t k = 0; k < size; ++k) {
+        std::string_view token;
+        if (Status status = nextValue(kind, item, token); !status.ok()) {
+          return status;
+        }
+        int64_t value = 0;
+        if (!parseInteger(token, value)) {
+          return error(std::string(itemName(kind)) + " " +
+                       std::to_string(item) + ": " + quoted(token) +
+                       " is not a vertex index");
+        }
+        if (value < 1 || static_cast<uint64_t>(value) > vertexCount) {
+          return error(std::string(itemName(kind)) + " " +
+                       std::to_string(item) + ": vertex index " +
+                       std::to_string(value) + " is out of range (1 to " +
+                       std::to_string(vertexCount) + ")");
+        }
+        corners[k] = static_cast<uint32_t>(value - 1);
+      }
+      if (Status status = readReference(kind, item); !status.ok()) {
+        return status;
+      }
+      if (kind == Kind::Quadrilaterals) {
+        split_.append(corners, 4, target);
+      } else {
+        target.insert(target.end(), corners, corners + size);
+      }
+    }
+    return Status::success();
+  }
+
+  Status skipItems(const Section& section, uint64_t count) {
+    for (uint64_t item = 0; item < count; ++item) {
+      for (uint64_t k = 0; k < section.valuesPerItem; ++k) {
+        std::string_view token;
+        if (!scanner_.nextTokenAcrossLines(token)) {
+          return error("the file ends inside " + std::string(section.keyword) +
+                       " item " + std::to_string(item));
+        }
+      }
+    }
+    if (count > 0) {
+      skipped_.push_back("skipped " + std::to_string(count) + " " +
+                         std::string(section.keyword) +
+                         " (not part of a simplicial complex)");
+    }
+    return Status::success();
+  }
+
+  Status nextValue(Kind kind, uint64_t item, std::string_view& token) {
+    if (!scanner_.nextTokenAcrossLines(token)) {
+      return error("the file ends inside " + std::string(itemName(kind)) +
+                   " " + std::to_string(item));
+    }
+    return Status::success();
+  }
+
+  Status readReference(Kind kind, uint64_t item) {
+    std::string_view token;
+    if (Status status = nextValue(kind, item, token); !status.ok()) {
+      return status;
+    }
+    int64_t reference = 0;
+    if (!parseInteger(token, reference)) {
+      return error(std::string(itemName(kind)) + " " + std::to_string(item) +
+                   ": reference " + quoted(token) + " is not an integer");
+    }
+    labelled_ += reference != 0;
+    return Status::success();
+  }
+
+  TextScanner scanner_;
+  Complex& out_;
+  bool sawVersion_ = false;
+  bool sawVertices_ = false;
+  bool doublePrecision_ = false;
+  size_t labelled_ = 0;
+  PolygonSplit split_;
+  std::vector<std::string> skipped_;
+};
+
+}  // namespace
+
+Status readMedit(const uint8_t* data, size_t size, Complex& out,
+                 Notes& notes) {
+  return MeditReader(data, size, out).read(notes);
+}
+
+Status writeMedit(const Complex& complex, std::vector<uint8_t>& out) {
+  if (!pointsAreImplicit(complex)) {
+    return Status::error(ErrorCode::InvalidArgument,
+                         "Medit cannot hold explicit points on vertices that "
+                         "simplices use");
+  }
+  TextOut text(out);
+  text.word("MeshVersionFormatted 1").endLine();
+  text.word("Dimension 3").endLine();
+  text.word("Vertices").endLine();
+  text.integer(complex.vertexCount()).endLine();
+  const std::vector<float>& positions = complex.positions;
+  for (size_t i = 0; i < positions.size(); i += 3) {
+    text.real(positions[i])
+        .real(positions[i + 1])
+        .real(positions[i + 2])
+        .integer(0)
+        .endLine();
+  }
+  const struct {
+    const char* keyword;
+    const std::vector<uint32_t>& indices;
+    size_t arity;
+  } sections[] = {{"Edges", complex.edges, 2},
+                  {"Triangles", complex.triangles, 3},
+                  {"Tetrahedra", complex.tetrahedra, 4}};
+  for (const auto& section : sections) {
+    if (section.indices.empty()) continue;
+    text.word(section.keyword).endLine();
+    text.integer(section.indices.size() / section.arity).endLine();
+    for (size_t i = 0; i < section.indices.size(); i += section.arity) {
+      for (size_t k = 0; k < section.arity; ++k) {
+        text.integer(uint64_t{section.indices[i + k]} + 1);  // 1-based
+      }
+      text.integer(0).endLine();
+    }
+  }
+  text.word("End").endLine();
+  return Status::success();
+}
+
+}  // namespace kdmesh::io::detail
