@@ -39,6 +39,25 @@ echo
 ./build-bench/kdmesh_bench_points --runs "$runs" $bits $models
 echo
 
+echo "## Meshes: kdmesh vs Draco edgebreaker, in process (warm medians of $runs runs)"
+echo
+meshes="build/models/triceratops.off"
+if [ "$quick" = 0 ]; then
+  meshes="$meshes $(ls ../shared/models/bunny.obj 2>/dev/null || true) $dragon"
+  ./build-bench/kdmesh_bench_mesh --runs "$runs" --bits 10 build/models/fandisk.off
+  echo
+fi
+# shellcheck disable=SC2086
+./build-bench/kdmesh_bench_mesh --runs "$runs" $bits $meshes
+echo
+if [ "$quick" = 0 ]; then
+  echo "Peak memory of the command-line tools on the dragon (12 bits, /usr/bin/time -v):"
+  echo
+  /usr/bin/time -f "encode: %e s, %M KB peak" ./build-bench/kdmesh encode "$dragon" -o build-bench/dragon.kdm --bits 12 -q
+  /usr/bin/time -f "decode: %e s, %M KB peak" ./build-bench/kdmesh decode build-bench/dragon.kdm -o build-bench/dragon.ply -q
+  echo
+fi
+
 echo "## Point clouds: file sizes from the command-line tools"
 echo
 echo "| model | bits | kdmesh bytes | kdmesh bpv | draco_encoder -point_cloud -cl 10 bytes | Draco bpv |"

@@ -222,8 +222,17 @@ struct Decoder::State {
     std::vector<uint32_t>* lists[4] = {nullptr, &out.edges, &out.triangles, &out.tetrahedra};
     for (int d = 1; d <= 3; ++d) {
       std::vector<uint32_t>& list = *lists[d];
+      // Once complete, the header says how many simplices of a dimension
+      // are maximal: none, or all of them, spares the test (a pure triangle
+      // mesh has no maximal edges and only maximal triangles).
+      const uint32_t maximal = header.simplexCounts[size_t(d)];
+      const bool finished = complete();
+      if (finished && maximal == 0) continue;
+      const bool testFaces = !finished || maximal != store.liveCount(d);
+      list.reserve(size_t(finished ? maximal : 0) * size_t(d + 1));
       for (uint32_t simplex = 0; simplex < store.size(d); ++simplex) {
-        if (!(store.flags(d, simplex) & SimplexStore::kAlive) || store.isFace(d, simplex)) continue;
+        if (!(store.flags(d, simplex) & SimplexStore::kAlive)) continue;
+        if (testFaces && store.isFace(d, simplex)) continue;
         const uint32_t* v = store.vertices(d, simplex);
         const size_t at = list.size();
         list.insert(list.end(), v, v + d + 1);
