@@ -1,7 +1,9 @@
 #!/bin/sh
-# Everything CI checks: build once, then run every test suite.
+# Everything CI checks: build once, then run every test suite (GoogleTest
+# through ctest, then the Node tests of the WebAssembly decoder).
 set -eu
 cd "$(dirname "$0")/.."
 sh scripts/build.sh
 sh scripts/models.sh
 ctest --test-dir build --output-on-failure -j"$(nproc)"
+node --test tests/js/

@@ -127,13 +127,17 @@ struct EncodeArgs {
   bool exact = false;
   size_t chunkBytes = 16 * 1024;
   bool pointsOnly = false;
+  bool weld = false;
 };
 
 int runEncode(const EncodeArgs& args) {
   const auto start = Clock::now();
   kdmesh::Complex complex;
   kdmesh::io::Notes notes;
-  if (auto s = kdmesh::io::readFile(args.input, complex, notes); !s.ok()) return fail(s, args.input);
+  kdmesh::io::ReadOptions readOptions;
+  readOptions.weld = args.weld;
+  if (auto s = kdmesh::io::readFile(args.input, complex, notes, readOptions); !s.ok())
+    return fail(s, args.input);
   for (const std::string& n : notes) note(args.input + ": " + n);
   if (args.pointsOnly && complex.hasSimplices()) {
     note("--points-only: dropping " + std::to_string(complex.simplexCount(1)) + " edges, " +
@@ -306,8 +310,12 @@ int main(int argc, char** argv) {
   app.add_flag("-q,--quiet", gQuiet, "No progress or statistics on stderr");
 
   EncodeArgs encodeArgs;
-  CLI::App* encode = app.add_subcommand("encode", "Compress a PLY, OBJ, OFF or XYZ file to .kdm");
-  encode->add_option("input", encodeArgs.input, "Input file (.ply .obj .off .xyz)")->required()->check(CLI::ExistingFile);
+  CLI::App* encode = app.add_subcommand(
+      "encode", "Compress a PLY, OBJ, OFF, XYZ, STL, Medit, TetGen or VTK file to .kdm");
+  encode->add_option("input", encodeArgs.input,
+                     "Input file (.ply .obj .off .xyz .stl .mesh .node/.ele .vtk)")
+      ->required()
+      ->check(CLI::ExistingFile);
   encode->add_option("-o,--output", encodeArgs.output, "Output .kdm file")->required();
   auto* bits = encode->add_option("--bits", encodeArgs.bits,
                                   "Grid bits of the longest bounding-box axis (1-30)")
@@ -320,11 +328,15 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   encode->add_flag("--points-only", encodeArgs.pointsOnly,
                    "Drop edges, triangles and tetrahedra and encode the vertices");
+  encode->add_flag("--weld", encodeArgs.weld,
+                   "Merge vertices with bit-identical positions (for STL triangle soups)");
 
   DecodeArgs decodeArgs;
   CLI::App* decode = app.add_subcommand("decode", "Decompress a .kdm file (or a prefix of it)");
   decode->add_option("input", decodeArgs.input, "Input .kdm file")->required()->check(CLI::ExistingFile);
-  decode->add_option("-o,--output", decodeArgs.output, "Output file (.ply .obj .off .xyz)")->required();
+  decode->add_option("-o,--output", decodeArgs.output,
+                     "Output file (.ply .obj .off .xyz .mesh .node .vtk)")
+      ->required();
   decode->add_option("--bytes", decodeArgs.bytes,
                      "Decode only the first N bytes: the model as a viewer sees it after N bytes");
   decode->add_flag("--ascii", decodeArgs.asciiPly, "Write ASCII instead of binary PLY");

@@ -1084,7 +1084,7 @@ TEST(IoFormat, FromPathByExtensionCaseInsensitively) {
       {"trailingdot.", Format::Unknown},
       {"model.ply.gz", Format::Unknown},
       {"model.kdm", Format::Unknown},
-      {"model.stl", Format::Unknown},
+      {"model.3mf", Format::Unknown},
       {"model.plyx", Format::Unknown},
       {"model.pl", Format::Unknown},
       {"dir.ply/file", Format::Unknown},

@@ -16,9 +16,20 @@
 
 namespace kdmesh::io {
 
-enum class Format : uint8_t { Unknown, Ply, Obj, Off, Xyz };
+enum class Format : uint8_t {
+  Unknown,
+  Ply,
+  Obj,
+  Off,
+  Xyz,
+  Stl,     // ascii or binary STL, read only
+  Medit,   // INRIA Medit .mesh, ascii
+  TetGen,  // TetGen .node (vertices) plus .ele (tetrahedra)
+  Vtk,     // legacy VTK, ascii
+};
 
-// By file extension, case-insensitive: .ply .obj .off .xyz (.txt, .pts -> Xyz).
+// By file extension, case-insensitive: .ply .obj .off .xyz (.txt, .pts -> Xyz)
+// .stl .mesh .vtk, and .node or .ele -> TetGen.
 Format formatFromPath(const std::string& path);
 const char* formatName(Format format);
 
@@ -27,9 +38,40 @@ const char* formatName(Format format);
 // is one line of text; repeated events are counted in one note.
 using Notes = std::vector<std::string>;
 
+struct ReadOptions {
+  // Merge vertices whose positions are bit-identical (so +0 and -0 stay
+  // apart), keeping the first of each and the order of first appearance, and
+  // renumber the simplices; a note gives the count. Meant for STL, a triangle
+  // soup with three vertices of its own per triangle, but works for every
+  // format. Simplices that welding leaves with a repeated vertex are kept
+  // (and noted): the encoder drops them as degenerate.
+  bool weld = false;
+};
+
+// Format notes:
+// - STL: binary when the size is 84 + 50 * (the count at byte 80), or when
+//   the text is not "solid" followed by a "facet" or "endsolid" line (binary
+//   headers often start with "solid" too). Three new vertices per triangle,
+//   as given; facet normals and attribute bytes are ignored.
+// - Medit: Dimension 3 only. Quadrilaterals are split into two triangles
+//   (a note says how many); Hexahedra, Prisms, Pyramids, P2/Q2 elements and
+//   known per-item sections (Corners, Ridges, Required*, Normals, ...) are
+//   skipped with a note; any other keyword is an error naming it. References
+//   are ignored.
+// - TetGen: readFile on x.node or x.ele reads both files (x.ele is optional
+//   when x.node is given: without it the nodes are a point cloud). Point
+//   numbers may start at 0 or 1; 10-node tetrahedra keep their 4 corners.
+//   readMemory can read one buffer only, so it reads a .node alone.
+// - VTK: legacy ascii UNSTRUCTURED_GRID or POLYDATA, cells in the classic
+//   layout or the OFFSETS/CONNECTIVITY layout of version 5. Vertex and
+//   poly-vertex cells become points, lines and poly-lines edges, triangles
+//   and strips triangles, tetrahedra tetrahedra; quads and polygons are split
+//   into triangles with a note, other cell types are skipped with a note.
+//   POINT_DATA, CELL_DATA and FIELD data are ignored. Binary VTK is an error.
 Status readMemory(Format format, const uint8_t* data, size_t size,
-                  Complex& out, Notes& notes);
-Status readFile(const std::string& path, Complex& out, Notes& notes);
+                  Complex& out, Notes& notes, const ReadOptions& options = {});
+Status readFile(const std::string& path, Complex& out, Notes& notes,
+                const ReadOptions& options = {});
 
 struct WriteOptions {
   // PLY only: ascii instead of binary little-endian.
@@ -39,7 +81,10 @@ struct WriteOptions {
 // Text formats print 9 significant digits, enough to give back every float32
 // bit; binary PLY stores float32 as is. A format that cannot hold some
 // simplices of the complex (XYZ holds only vertices, OFF no tetrahedra) is an
-// InvalidArgument error rather than a silent loss.
+// InvalidArgument error rather than a silent loss. STL cannot be written.
+// TetGen: writeFile on x.node or x.ele writes x.node, plus x.ele when there
+// are tetrahedra or the path names the .ele; it holds no edges or triangles.
+// writeMemory(TetGen) gives the .node alone and so refuses tetrahedra.
 Status writeMemory(Format format, const Complex& complex,
                    std::vector<uint8_t>& out, const WriteOptions& options = {});
 Status writeFile(const std::string& path, const Complex& complex,

@@ -167,8 +167,8 @@ Status readTetgenFiles(const std::string& path, Complex& out, Notes& notes) {
     return inFile(inputError("file is empty"), paths.node, path);
   }
   uint32_t firstIndex = 0;
-  Status status =
-      detail::readTetgenNode(bytes.data(), bytes.size(), out, notes, firstIndex);
+  Status status = detail::readTetgenNode(bytes.data(), bytes.size(), out,
+                                         notes, firstIndex);
   if (!status.ok()) return inFile(status, paths.node, path);
 
   bool missing = false;

@@ -24,8 +24,8 @@ Status readHeader(TextScanner& scanner, const char* file, size_t required,
     return inputError(std::string("TetGen ") + file + " file has no header");
   }
   std::string_view token;
+  for (size_t i = 0; i < valueCount; ++i) values[i] = 0;
   for (size_t i = 0; i < valueCount; ++i) {
-    values[i] = 0;
     if (!scanner.nextToken(token)) {
       if (i < required) {
         return lineError(scanner.lineNumber(),
@@ -163,10 +163,20 @@ Status readTetgenNode(const uint8_t* data, size_t size, Complex& out,
         !status.ok()) {
       return status;
     }
-    bool unused = false;
-    if (Status status = readPositionLine(scanner, out.positions, unused);
-        !status.ok()) {
-      return status;
+    for (int axis = 0; axis < 3; ++axis) {
+      std::string_view token;
+      float value = 0;
+      if (!scanner.nextToken(token)) {
+        return lineError(scanner.lineNumber(),
+                         "point " + std::to_string(p) + " has " +
+                             std::to_string(axis) + " coordinates, needs 3");
+      }
+      if (!parseFloat(token, value)) {
+        return lineError(scanner.lineNumber(), "point " + std::to_string(p) +
+                                                   ": " + quoted(token) +
+                                                   " is not a number");
+      }
+      out.positions.push_back(value);
     }
     if (Status status = skipColumns(scanner, "point", p, attributes + markers,
                                     extraLines);
@@ -178,7 +188,8 @@ Status readTetgenNode(const uint8_t* data, size_t size, Complex& out,
   noteTrailingLines(scanner, ".node", count, "points", notes);
   if (attributes > 0 || markers > 0) {
     notes.push_back("ignored the " + std::to_string(attributes) +
-                    " attributes" + (markers ? " and the boundary marker" : "") +
+                    " attributes" +
+                    (markers ? " and the boundary marker" : "") +
                     " of every .node point");
   }
   addCountNote(notes, "ignored extra values on ", extraLines,
@@ -285,7 +296,11 @@ Status writeTetgenNode(const Complex& complex, std::vector<uint8_t>& out) {
   }
   TextOut text(out);
   text.word("# written by kdmesh").endLine();
-  text.integer(complex.vertexCount()).integer(3).integer(0).integer(0).endLine();
+  text.integer(complex.vertexCount())
+      .integer(3)
+      .integer(0)
+      .integer(0)
+      .endLine();
   const std::vector<float>& positions = complex.positions;
   for (size_t v = 0; v < complex.vertexCount(); ++v) {
     text.integer(v + 1)  // numbered from 1, as TetGen writes by default
@@ -304,7 +319,9 @@ Status writeTetgenEle(const Complex& complex, std::vector<uint8_t>& out) {
   text.integer(tetrahedra.size() / 4).integer(4).integer(0).endLine();
   for (size_t i = 0; i < tetrahedra.size(); i += 4) {
     text.integer(i / 4 + 1);
-    for (size_t k = 0; k < 4; ++k) text.integer(uint64_t{tetrahedra[i + k]} + 1);
+    for (size_t k = 0; k < 4; ++k) {
+      text.integer(uint64_t{tetrahedra[i + k]} + 1);
+    }
     text.endLine();
   }
   return Status::success();

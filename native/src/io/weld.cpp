@@ -62,8 +62,8 @@ void weldVertices(Complex& complex, Notes& notes) {
       continue;
     }
     newIndex[v] = kept;
-    std::memmove(&complex.positions[3 * size_t{kept}], &complex.positions[3 * v],
-                 3 * sizeof(float));
+    std::memmove(&complex.positions[3 * size_t{kept}],
+                 &complex.positions[3 * v], 3 * sizeof(float));
     ++kept;
   }
   if (kept == n) return;

@@ -1,0 +1,147 @@
+// The WebAssembly decoder against the native one, streaming, errors and
+// memory. Run with `node --test tests/js/`.
+import { test } from 'node:test';
+import assert from 'node:assert/strict';
+import { decode, createDecoder, KdmeshError, memoryInUse } from 'kdmesh';
+import { makeFixtures, nativeDecode } from './fixtures.mjs';
+
+const fixtures = makeFixtures();
+
+function isolatedVertices(model, vertexCount) {
+  const used = new Uint8Array(vertexCount);
+  for (const list of [model.edges, model.triangles, model.tetrahedra]) for (const v of list) used[v] = 1;
+  const isolated = [];
+  for (let v = 0; v < vertexCount; ++v) if (!used[v]) isolated.push(v);
+  return isolated;
+}
+
+function assertSameModel(wasm, native, what) {
+  assert.equal(wasm.vertexCount, native.positions.length / 3, `${what}: vertex count`);
+  assert.deepEqual(new Uint32Array(wasm.positions.buffer.slice(0)), new Uint32Array(native.positions.buffer.slice(0)), `${what}: position bits`);
+  assert.deepEqual(Array.from(wasm.edges), native.edges, `${what}: edges`);
+  assert.deepEqual(Array.from(wasm.triangles), native.triangles, `${what}: triangles`);
+  assert.deepEqual(Array.from(wasm.tetrahedra), native.tetrahedra, `${what}: tetrahedra`);
+  if (native.edges.length + native.triangles.length + native.tetrahedra.length > 0)
+    assert.deepEqual(Array.from(wasm.points), isolatedVertices(native, wasm.vertexCount), `${what}: isolated points`);
+}
+
+test('whole streams decode exactly as the native decoder does', async () => {
+  for (const [name, { kdm, bytes }] of Object.entries(fixtures)) {
+    const model = await decode(bytes);
+    assert.equal(model.complete, true);
+    assertSameModel(model, nativeDecode(kdm), name);
+  }
+});
+
+test('prefixes decode exactly as the native decoder does', async () => {
+  for (const name of ['torus-12', 'tetrahedra-exact', 'mixed-12', 'cloud-12', 'triceratops.off']) {
+    const { kdm, bytes } = fixtures[name];
+    for (const fraction of [0.02, 0.1, 0.35, 0.7]) {
+      const cut = Math.max(100, Math.floor(bytes.length * fraction));
+      const decoder = await createDecoder();
+      decoder.push(bytes.subarray(0, cut));
+      const model = decoder.snapshot();
+      decoder.dispose();
+      assert.equal(model.complete, false);
+      assertSameModel(model, nativeDecode(kdm, cut), `${name} at ${cut} bytes`);
+    }
+  }
+});
+
+test('streaming in random pieces, down to single bytes, gives the snapshots of the same prefixes', async () => {
+  let seed = 12345;
+  const random = () => (seed = (Math.imul(seed, 1103515245) + 12345) >>> 0) / 2 ** 32;
+  for (const name of ['torus-12', 'mixed-exact', 'cloud-12']) {
+    const { bytes } = fixtures[name];
+    const streaming = await createDecoder();
+    for (let at = 0; at < bytes.length;) {
+      const size = random() < 0.3 ? 1 : 1 + Math.floor(random() * 700);
+      streaming.push(bytes.subarray(at, at + size));
+      at = Math.min(bytes.length, at + size);
+      if (random() < 0.15 || at === bytes.length) {
+        const once = await createDecoder();
+        once.push(bytes.subarray(0, at));
+        assert.deepEqual(streaming.snapshot(), once.snapshot(), `${name} at ${at} bytes`);
+        assert.deepEqual(streaming.progress, once.progress);
+        once.dispose();
+      }
+    }
+    streaming.finish();
+    streaming.dispose();
+  }
+});
+
+test('one byte at a time works', async () => {
+  const { bytes } = fixtures['mixed-12'];
+  const decoder = await createDecoder();
+  for (let i = 0; i < bytes.length; ++i) decoder.push(bytes.subarray(i, i + 1));
+  decoder.finish();
+  assert.deepEqual(decoder.snapshot(), await decode(bytes));
+  decoder.dispose();
+});
+
+async function rejection(bytes, options) {
+  try {
+    await decode(bytes, options);
+  } catch (error) {
+    assert.ok(error instanceof KdmeshError, `${error}`);
+    assert.ok(error.message.length > 0);
+    return error.code;
+  }
+  assert.fail('decoding should have failed');
+}
+
+test('bad streams reject with the documented codes', async () => {
+  const { bytes } = fixtures['torus-12'];
+  const copy = () => Uint8Array.from(bytes);
+  const badMagic = copy();
+  badMagic[1] ^= 0xff;
+  assert.equal(await rejection(badMagic), 'bad-magic');
+  const badHeader = copy();
+  badHeader[20] ^= 1;
+  assert.equal(await rejection(badHeader), 'corrupt-header');
+  const badChunk = copy();
+  badChunk[bytes.length - 3] ^= 0x10;
+  assert.equal(await rejection(badChunk), 'corrupt-chunk');
+  assert.equal(await rejection(bytes.subarray(0, bytes.length - 1)), 'truncated');
+  assert.equal(await rejection(Buffer.concat([bytes, Buffer.from([0])])), 'trailing-bytes');
+  assert.equal(await rejection(bytes, { limits: { maxVertices: 10 } }), 'limit-exceeded');
+  assert.equal(await rejection(new Uint8Array(0)), 'truncated');
+});
+
+test('a failed decoder stays failed and can still be disposed; a disposed one refuses work', async () => {
+  const { bytes } = fixtures['cloud-12'];
+  const decoder = await createDecoder();
+  const bad = Uint8Array.from(bytes);
+  bad[0] = 0;
+  assert.throws(() => decoder.push(bad), (e) => e.code === 'bad-magic');
+  assert.throws(() => decoder.push(bytes), (e) => e.code === 'bad-magic');
+  decoder.dispose();
+  decoder.dispose();
+  assert.throws(() => decoder.snapshot(), (e) => e.code === 'disposed');
+});
+
+test('views without copies read the same data', async () => {
+  const { bytes } = fixtures['torus-12'];
+  const decoder = await createDecoder();
+  decoder.push(bytes);
+  const view = decoder.snapshot({ copy: false });
+  const copied = decoder.snapshot();
+  assert.deepEqual(Array.from(view.triangles), Array.from(copied.triangles));
+  assert.equal(decoder.parents().length, copied.vertexCount);
+  decoder.dispose();
+});
+
+test('memory stays flat across 1,000 decode/dispose cycles', async () => {
+  const { bytes } = fixtures['torus-12'];
+  for (let i = 0; i < 20; ++i) await decode(bytes);
+  const before = await memoryInUse();
+  for (let i = 0; i < 1000; ++i) {
+    const decoder = await createDecoder();
+    decoder.push(bytes.subarray(0, bytes.length >> 1));
+    decoder.snapshot({ copy: false });
+    decoder.dispose();
+    await decode(bytes);
+  }
+  assert.equal(await memoryInUse(), before);
+});

@@ -1,0 +1,82 @@
+// Type declarations for kdmesh (web/kdmesh.js).
+
+/** An error from the decoder. `code` is stable: 'bad-magic', 'unsupported-version',
+ * 'corrupt-header', 'corrupt-chunk', 'truncated', 'trailing-bytes', 'limit-exceeded',
+ * 'disposed', 'invalid-argument', 'out-of-memory' or 'wasm-unavailable'. */
+export class KdmeshError extends Error {
+  readonly code: string;
+}
+
+/** Caps on what a stream may ask for; exceeding one is a 'limit-exceeded' error. */
+export interface DecoderLimits {
+  maxVertices?: number;
+  maxSimplices?: number;
+  maxChunkBytes?: number;
+}
+
+export interface DecoderOptions {
+  limits?: DecoderLimits;
+}
+
+export interface Header {
+  vertexCount: number;
+  maxDimension: number;
+  /** Maximal simplices per dimension 0..3 of the complete model ([0]: isolated points). */
+  simplexCounts: [number, number, number, number];
+  quantization: 'grid' | 'float32';
+  bits: number;
+  step: number;
+  totalBytes: number;
+  chunkCount: number;
+}
+
+export interface Progress {
+  bytesReceived: number;
+  bytesConsumed: number;
+  bytesExpected: number;
+  chunksApplied: number;
+  level: number;
+  vertexCount: number;
+  complete: boolean;
+  /** No input vertex is farther than this from its snapshot vertex. */
+  errorBound: number;
+}
+
+export interface Model {
+  vertexCount: number;
+  /** xyz, 3 floats per vertex. */
+  positions: Float32Array;
+  /** Isolated vertices. */
+  points: Uint32Array;
+  /** 2 indices per edge. */
+  edges: Uint32Array;
+  /** 3 indices per triangle, in the input's winding. */
+  triangles: Uint32Array;
+  /** 4 indices per tetrahedron, in the input's orientation. */
+  tetrahedra: Uint32Array;
+  complete: boolean;
+  stats: { bytes: number; level: number; chunks: number; errorBound: number; bitsPerVertex: number };
+}
+
+export class Decoder {
+  /** Feeds bytes (any split); applies every whole chunk. Throws KdmeshError on bad data. */
+  push(bytes: Uint8Array | ArrayBuffer): Progress;
+  /** Throws KdmeshError('truncated') unless the stream is complete. */
+  finish(): void;
+  readonly header: Header | null;
+  readonly progress: Progress;
+  /** The current level. With copy: false the arrays view WebAssembly memory and are
+   * valid only until the next call on this decoder. */
+  snapshot(options?: { copy?: boolean }): Model;
+  /** parents[v]: the vertex that v was split from (connectivity streams). */
+  parents(): Uint32Array;
+  /** Frees the decoder's WebAssembly memory. */
+  dispose(): void;
+}
+
+/** Where to load the WebAssembly decoder from (a URL, or the .wasm bytes). Default: embedded. */
+export function setWasmSource(source: string | URL | ArrayBuffer | ArrayBufferView): void;
+export function createDecoder(options?: DecoderOptions): Promise<Decoder>;
+export function decode(bytes: Uint8Array | ArrayBuffer, options?: DecoderOptions): Promise<Model>;
+/** Bytes of WebAssembly heap in use (diagnostics). */
+export function memoryInUse(): Promise<number>;

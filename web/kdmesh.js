@@ -1,0 +1,251 @@
+// kdmesh — progressive decoding of .kdm streams in browsers and Node, with
+// the same C++ decoder as the native tools, compiled to WebAssembly.
+//
+//   import { decode, createDecoder } from 'kdmesh';
+//   const model = await decode(bytes);                // whole stream
+//   const decoder = await createDecoder();            // or piece by piece
+//   decoder.push(piece);                              // any split of the bytes
+//   const coarse = decoder.snapshot();                // the current level
+//   decoder.dispose();
+//
+// The WebAssembly binary is embedded in the package (base64, loaded on first
+// use), so nothing needs configuring under Node or a bundler. To serve the
+// .wasm file yourself, call setWasmSource(url) before the first decoder.
+
+import createKdmeshModule from './dist/kdmesh-wasm.js';
+
+/** An error from the decoder, with a stable `code` such as 'corrupt-chunk'. */
+export class KdmeshError extends Error {
+  constructor(code, message) {
+    super(message);
+    this.name = 'KdmeshError';
+    this.code = code;
+  }
+}
+
+let wasmSource;
+let modulePromise;
+
+/**
+ * Where the WebAssembly decoder comes from: a URL (string or URL, fetched and
+ * compiled with WebAssembly.instantiateStreaming), or the bytes of
+ * kdmesh-wasm.wasm (ArrayBuffer or typed array). Call before the first
+ * decoder is created; the default is the copy embedded in the package.
+ */
+export function setWasmSource(source) {
+  if (modulePromise) throw new KdmeshError('invalid-argument', 'setWasmSource must be called before the first decoder');
+  wasmSource = source;
+}
+
+function base64Bytes(text) {
+  if (typeof Buffer === 'function') return new Uint8Array(Buffer.from(text, 'base64'));
+  const binary = atob(text);
+  const bytes = new Uint8Array(binary.length);
+  for (let i = 0; i < binary.length; ++i) bytes[i] = binary.charCodeAt(i);
+  return bytes;
+}
+
+async function instantiate(source) {
+  const options = {};
+  if (source === undefined) {
+    const { wasmBase64 } = await import('./dist/kdmesh-wasm-binary.js');
+    options.wasmBinary = base64Bytes(wasmBase64);
+  } else if (source instanceof ArrayBuffer || ArrayBuffer.isView(source)) {
+    options.wasmBinary = source instanceof ArrayBuffer ? new Uint8Array(source) : source;
+  } else {
+    const url = String(source);
+    options.instantiateWasm = (imports, receive) => {
+      const response = fetch(url, { credentials: 'same-origin' });
+      const compiled = typeof WebAssembly.instantiateStreaming === 'function'
+        ? WebAssembly.instantiateStreaming(response, imports)
+        : response.then((r) => r.arrayBuffer()).then((b) => WebAssembly.instantiate(b, imports));
+      compiled.then((result) => receive(result.instance), (error) => { throw error; });
+      return {};
+    };
+  }
+  return createKdmeshModule(options);
+}
+
+function loadModule() {
+  if (!modulePromise) {
+    modulePromise = instantiate(wasmSource).catch((error) => {
+      modulePromise = undefined;
+      throw new KdmeshError('wasm-unavailable', `cannot load the kdmesh WebAssembly decoder: ${error.message ?? error}`);
+    });
+  }
+  return modulePromise;
+}
+
+const HEADER_FIELDS = 11;
+const PROGRESS_FIELDS = 8;
+const EMPTY_INDICES = new Uint32Array(0);
+
+/** A progressive decoder; create it with createDecoder(). */
+export class Decoder {
+  #module;
+  #handle;
+  #scratch;  // doubles shared with the C API
+  #error;    // sticky: a failed decoder stays failed
+
+  constructor(module, options = {}) {
+    this.#module = module;
+    const limits = options.limits ?? {};
+    this.#handle = module._kdm_create(limits.maxVertices >>> 0, limits.maxSimplices >>> 0, limits.maxChunkBytes >>> 0);
+    this.#scratch = module._malloc(8 * Math.max(HEADER_FIELDS, PROGRESS_FIELDS));
+    if (!this.#handle || !this.#scratch) throw new KdmeshError('out-of-memory', 'cannot allocate a decoder');
+  }
+
+  #live() {
+    if (!this.#handle) throw new KdmeshError('disposed', 'the decoder has been disposed');
+    if (this.#error) throw this.#error;
+    return this.#module;
+  }
+
+  #check(code) {
+    if (code === 0) return;
+    const m = this.#module;
+    const name = m.UTF8ToString(m._kdm_error_name(code));
+    this.#error = new KdmeshError(name, m.UTF8ToString(m._kdm_error_message(this.#handle)));
+    throw this.#error;
+  }
+
+  #doubles(count) {
+    return new Float64Array(this.#module.HEAPU8.buffer, this.#scratch, count);
+  }
+
+  /**
+   * Feeds the next bytes of the stream (any split, even one byte at a time).
+   * Applies every whole chunk and keeps the rest buffered. Throws a
+   * KdmeshError on corrupt data; the decoder then stays failed.
+   */
+  push(bytes) {
+    const m = this.#live();
+    const view = bytes instanceof Uint8Array ? bytes : new Uint8Array(bytes);
+    const at = m._kdm_input(this.#handle, view.length);
+    m.HEAPU8.set(view, at);
+    this.#check(m._kdm_push(this.#handle, view.length));
+    return this.progress;
+  }
+
+  /** Throws unless the stream is complete (e.g. 'truncated'). */
+  finish() {
+    const m = this.#live();
+    this.#check(m._kdm_finish(this.#handle));
+  }
+
+  /** Header fields once its 96 bytes have arrived, else null. */
+  get header() {
+    const m = this.#live();
+    if (!m._kdm_has_header(this.#handle)) return null;
+    m._kdm_header(this.#handle, this.#scratch);
+    const f = this.#doubles(HEADER_FIELDS);
+    return {
+      vertexCount: f[0],
+      maxDimension: f[1],
+      simplexCounts: [f[2], f[3], f[4], f[5]],
+      quantization: f[6] === 0 ? 'grid' : 'float32',
+      bits: f[7],
+      step: f[8],
+      totalBytes: f[9],
+      chunkCount: f[10],
+    };
+  }
+
+  /** { bytesReceived, bytesConsumed, bytesExpected, chunksApplied, level, vertexCount, complete, errorBound } */
+  get progress() {
+    const m = this.#live();
+    m._kdm_progress(this.#handle, this.#scratch);
+    const f = this.#doubles(PROGRESS_FIELDS);
+    return {
+      bytesReceived: f[0],
+      bytesConsumed: f[1],
+      bytesExpected: f[2],
+      chunksApplied: f[3],
+      level: f[4],
+      vertexCount: f[5],
+      complete: f[6] === 1,
+      errorBound: f[7],
+    };
+  }
+
+  /**
+   * The model at the current level: { vertexCount, positions, points, edges,
+   * triangles, tetrahedra, complete, stats }. With { copy: false } the arrays
+   * are views of WebAssembly memory, valid only until the next call on this
+   * decoder; by default they are copies the caller may keep.
+   */
+  snapshot({ copy = true } = {}) {
+    const m = this.#live();
+    const h = this.#handle;
+    m._kdm_snapshot(h);
+    const vertexCount = m._kdm_vertex_count(h);
+    const take = (array) => (copy ? array.slice() : array);
+    const positions = take(new Float32Array(m.HEAPU8.buffer, m._kdm_positions(h), 3 * vertexCount));
+    const indices = (dimension) => {
+      const count = m._kdm_index_count(h, dimension);
+      return count ? take(new Uint32Array(m.HEAPU8.buffer, m._kdm_indices(h, dimension), count)) : EMPTY_INDICES;
+    };
+    const progress = this.progress;
+    return {
+      vertexCount,
+      positions,
+      points: indices(0),
+      edges: indices(1),
+      triangles: indices(2),
+      tetrahedra: indices(3),
+      complete: progress.complete,
+      stats: {
+        bytes: progress.bytesConsumed,
+        level: progress.level,
+        chunks: progress.chunksApplied,
+        errorBound: progress.errorBound,
+        bitsPerVertex: vertexCount ? (8 * progress.bytesConsumed) / vertexCount : 0,
+      },
+    };
+  }
+
+  /**
+   * For streams with connectivity: parents[v] is the vertex that v was split
+   * from (vertex ids are stable across snapshots), e.g. to animate a newly
+   * split vertex from its parent's position. A copy.
+   */
+  parents() {
+    const m = this.#live();
+    const count = m._kdm_parent_count(this.#handle);
+    return new Uint32Array(m.HEAPU8.buffer, m._kdm_parents(this.#handle), count).slice();
+  }
+
+  /** Frees the decoder's WebAssembly memory; the decoder is unusable after. */
+  dispose() {
+    if (!this.#handle) return;
+    this.#module._kdm_destroy(this.#handle);
+    this.#module._free(this.#scratch);
+    this.#handle = 0;
+    this.#scratch = 0;
+  }
+}
+
+/**
+ * Bytes of WebAssembly heap in use by all decoders (diagnostics: it returns
+ * to the same value once every decoder is disposed).
+ */
+export async function memoryInUse() {
+  return (await loadModule())._kdm_heap_in_use();
+}
+
+/** A new progressive decoder. Options: { limits: { maxVertices, maxSimplices, maxChunkBytes } }. */
+export async function createDecoder(options = {}) {
+  return new Decoder(await loadModule(), options);
+}
+
+/** Decodes a whole stream; rejects with a KdmeshError on corrupt or truncated data. */
+export async function decode(bytes, options = {}) {
+  const decoder = await createDecoder(options);
+  try {
+    decoder.push(bytes);
+    decoder.finish();
+    return decoder.snapshot();
+  } finally {
+    decoder.dispose();
+  }
+}
