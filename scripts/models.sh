@@ -21,3 +21,19 @@ for name in triceratops fandisk; do
     mv "build/models/$name.off.tmp" "build/models/$name.off"
   fi
 done
+
+# A Delaunay tetrahedralization of 10,000 random points in a ball (fixed
+# seed), made by TetGen: the paper's tetrahedral benchmark.
+if [ ! -f build/models/ball10k.1.ele ]; then
+  node -e '
+    let s = 20021;
+    const r = () => (s = (Math.imul(s, 1664525) + 1013904223) >>> 0) / 2 ** 32;
+    const lines = ["10000 3 0 0"];
+    for (let i = 1; i <= 10000;) {
+      const x = 2 * r() - 1, y = 2 * r() - 1, z = 2 * r() - 1;
+      if (x * x + y * y + z * z <= 1) lines.push(`${i++} ${x} ${y} ${z}`);
+    }
+    require("fs").writeFileSync("build/models/ball10k.node", lines.join("\n") + "\n");
+  '
+  tetgen -Q build/models/ball10k.node >/dev/null
+fi

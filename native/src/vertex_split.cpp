@@ -87,17 +87,18 @@ int VertexSplitter::predictFlip(int dimension, uint32_t simplex, int& voteClass)
   auto consider = [&](uint32_t other) {
     if (other == simplex || (store_.flags(dimension, other) & SimplexStore::kUndecided)) return;
     const uint32_t* theirs = store_.vertices(dimension, other);
-    // They are neighbours when they share all vertices but one each.
+    // They are neighbours when they share all vertices but one each; most
+    // candidates miss two vertices early.
     uint32_t mineOnly = 0, theirsOnly = 0;
     int missing = 0;
     for (int i = 0; i < arity; ++i) {
-      if (!containsVertex(theirs, arity, mine[i])) {
-        mineOnly = mine[i];
-        ++missing;
-      }
-      if (!containsVertex(mine, arity, theirs[i])) theirsOnly = theirs[i];
+      if (containsVertex(theirs, arity, mine[i])) continue;
+      if (++missing > 1) return;
+      mineOnly = mine[i];
     }
     if (missing != 1) return;
+    for (int i = 0; i < arity; ++i)
+      if (!containsVertex(mine, arity, theirs[i])) theirsOnly = theirs[i];
     // Orientation each induces on the shared facet; consistent neighbours
     // induce opposite ones.
     const int mySign = myParity ^ (rankOf(mine, arity, mineOnly) & 1);
