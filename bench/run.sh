@@ -58,6 +58,17 @@ if [ "$quick" = 0 ]; then
   echo
 fi
 
+echo "## WebAssembly decoder in Node (warm medians)"
+echo
+sh scripts/build-wasm.sh >/dev/null
+if [ "$quick" = 1 ]; then
+  node bench/wasm-bench.mjs --quick build/models/triceratops.off
+else
+  # shellcheck disable=SC2086
+  node bench/wasm-bench.mjs build/models/triceratops.off $(ls ../shared/models/bunny.obj 2>/dev/null || true) "$dragon"
+fi
+echo
+
 echo "## Point clouds: file sizes from the command-line tools"
 echo
 echo "| model | bits | kdmesh bytes | kdmesh bpv | draco_encoder -point_cloud -cl 10 bytes | Draco bpv |"

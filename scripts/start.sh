@@ -1,11 +1,9 @@
 #!/bin/sh
-# The main job: build, encode the default model (the Stanford dragon) and
-# print what the stream holds.
+# The main job: install what is missing, build, encode the gallery, serve the
+# progressive viewer and print its URL. PORT (default 8080) picks the port.
 set -eu
 cd "$(dirname "$0")/.."
 sh scripts/build.sh
-sh scripts/models.sh
-model=build/models/dragon_vrip.ply
-mkdir -p out
-./build/kdmesh encode "$model" -o out/dragon.kdm --bits 12
-./build/kdmesh info out/dragon.kdm
+if [ ! -d node_modules/three ]; then npm install --no-audit --no-fund; fi
+sh scripts/gallery.sh
+exec node web/server.mjs --root out --port "${PORT:-8080}"

@@ -6,4 +6,4 @@ cd "$(dirname "$0")/.."
 sh scripts/build.sh
 sh scripts/models.sh
 ctest --test-dir build --output-on-failure -j"$(nproc)"
-node --test tests/js/
+node --test tests/js/ tests/browser/

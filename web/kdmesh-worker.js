@@ -1,0 +1,99 @@
+// Module worker behind KDMeshLoader: decodes the stream off the main thread
+// and hands back snapshots as transferable arrays, one at a time, when the
+// page asks for the next one (so a fast network never floods the page).
+//
+// Messages in:  {type: 'start', wasmSource?}, {type: 'bytes', bytes},
+//               {type: 'end'}, {type: 'next'} (the page is ready for a snapshot)
+// Messages out: {type: 'header', header}, {type: 'snapshot', model} (the
+//               last one has model.complete), {type: 'error', code, message}
+import { createDecoder, setWasmSource } from './kdmesh.js';
+
+let decoder = null;
+let failed = false;
+let wanted = true;        // the page is ready for a snapshot
+let changed = false;      // chunks were applied since the last snapshot
+let headerSent = false;
+let queue = Promise.resolve();
+
+// Faces of the tetrahedra that belong to exactly one: the visible surface of
+// a tetrahedral mesh, oriented outwards when the tetrahedra are positive.
+function boundaryOfTetrahedra(tetrahedra) {
+  const faces = new Map();
+  const corners = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]];
+  for (let t = 0; t < tetrahedra.length; t += 4) {
+    for (const [a, b, c] of corners) {
+      const face = [tetrahedra[t + a], tetrahedra[t + b], tetrahedra[t + c]];
+      const key = face.slice().sort((x, y) => x - y).join(',');
+      if (faces.has(key)) faces.delete(key);
+      else faces.set(key, face);
+    }
+  }
+  const out = new Uint32Array(faces.size * 3);
+  let i = 0;
+  for (const face of faces.values()) out.set(face, 3 * i++);
+  return out;
+}
+
+function sendSnapshot() {
+  if (!decoder || !wanted || !changed) return;
+  const model = decoder.snapshot();
+  model.boundary = model.tetrahedra.length ? boundaryOfTetrahedra(model.tetrahedra) : new Uint32Array(0);
+  model.parents = decoder.parents();
+  model.progress = decoder.progress;
+  wanted = false;
+  changed = false;
+  const buffers = [model.positions, model.points, model.edges, model.triangles, model.tetrahedra, model.boundary,
+    model.parents].map((a) => a.buffer).filter((b, i, all) => b.byteLength && all.indexOf(b) === i);
+  postMessage({ type: 'snapshot', model }, buffers);
+}
+
+function fail(error) {
+  failed = true;
+  postMessage({ type: 'error', code: error.code ?? 'error', message: error.message ?? String(error) });
+  decoder?.dispose();
+  decoder = null;
+}
+
+function handle(message) {
+  if (failed) return;
+  try {
+    switch (message.type) {
+      case 'bytes': {
+        const before = decoder.progress.chunksApplied;
+        decoder.push(message.bytes);
+        if (!headerSent && decoder.header) {
+          headerSent = true;
+          postMessage({ type: 'header', header: decoder.header });
+        }
+        if (decoder.progress.chunksApplied !== before) changed = true;
+        sendSnapshot();
+        break;
+      }
+      case 'end':
+        decoder.finish();
+        sendSnapshot();
+        break;
+      case 'next':
+        wanted = true;
+        sendSnapshot();
+        break;
+    }
+  } catch (error) {
+    fail(error);
+  }
+}
+
+onmessage = ({ data }) => {
+  if (data.type === 'start') {
+    queue = queue.then(async () => {
+      try {
+        if (data.wasmSource) setWasmSource(data.wasmSource);
+        decoder = await createDecoder(data.options ?? {});
+      } catch (error) {
+        fail(error);
+      }
+    });
+    return;
+  }
+  queue = queue.then(() => handle(data));
+};

@@ -1,0 +1,203 @@
+// The kdmesh viewer: streams a .kdm model into three.js and shows it refine.
+// Query: ?model=NAME_OR_URL&throttle=KBPS. State for scripts and tests lives
+// in window.kdmeshViewer.
+import * as THREE from 'three';
+import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { KDMeshLoader } from 'kdmesh/three';
+
+const $ = (id) => document.getElementById(id);
+const viewer = (window.kdmeshViewer = {
+  state: 'idle', refinements: 0, vertexCount: 0, triangleCount: 0, tetrahedronCount: 0, edgeCount: 0,
+  pointCount: 0, bytesReceived: 0, bytesExpected: 0, level: 0, error: null, checksum: null, firstRenderMs: null,
+  completeMs: null, levelsSeen: [],
+  // Pixels of the last frame that differ from the background (for tests).
+  modelPixels() {
+    renderer.render(scene, camera);
+    const canvas = document.createElement('canvas');
+    canvas.width = renderer.domElement.width;
+    canvas.height = renderer.domElement.height;
+    const context = canvas.getContext('2d');
+    context.drawImage(renderer.domElement, 0, 0);
+    const { data } = context.getImageData(0, 0, canvas.width, canvas.height);
+    const [r, g, b] = [0xf4, 0xf6, 0xf8];
+    let count = 0;
+    for (let i = 0; i < data.length; i += 4)
+      if (Math.abs(data[i] - r) + Math.abs(data[i + 1] - g) + Math.abs(data[i + 2] - b) > 24) ++count;
+    return count;
+  },
+});
+
+const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+renderer.setPixelRatio(Math.min(2, window.devicePixelRatio));
+$('view').appendChild(renderer.domElement);
+const scene = new THREE.Scene();
+scene.background = new THREE.Color(0xf4f6f8);
+const camera = new THREE.PerspectiveCamera(40, 1, 0.001, 1000);
+const controls = new OrbitControls(camera, renderer.domElement);
+scene.add(new THREE.HemisphereLight(0xffffff, 0x445566, 1.6));
+const sun = new THREE.DirectionalLight(0xffffff, 1.8);
+camera.add(sun);
+sun.position.set(1, 2, 3);
+scene.add(camera);
+
+function resize() {
+  const { clientWidth: w, clientHeight: h } = $('view');
+  renderer.setSize(w, h, false);
+  camera.aspect = w / Math.max(1, h);
+  camera.updateProjectionMatrix();
+}
+window.addEventListener('resize', resize);
+resize();
+renderer.setAnimationLoop(() => {
+  controls.update();
+  renderer.render(scene, camera);
+});
+
+const loader = new KDMeshLoader();
+let current = null;
+let controller = null;
+let framed = false;
+
+// FNV-1a over the bits of the decoded arrays: lets tests compare the page's
+// final model with a Node decode of the same file.
+function checksum(model) {
+  let h = 0x811c9dc5;
+  for (const array of [model.positions, model.points, model.edges, model.triangles, model.tetrahedra]) {
+    const words = new Uint32Array(array.buffer, array.byteOffset, array.length);
+    for (let i = 0; i < words.length; ++i) h = Math.imul(h ^ words[i], 0x01000193) >>> 0;
+  }
+  return h.toString(16);
+}
+
+function frame(group) {
+  const box = new THREE.Box3().setFromObject(group);
+  if (box.isEmpty()) return;
+  const sphere = box.getBoundingSphere(new THREE.Sphere());
+  const distance = (sphere.radius || 1) / Math.sin(THREE.MathUtils.degToRad(camera.fov / 2));
+  camera.near = distance / 100;
+  camera.far = distance * 100;
+  camera.position.copy(sphere.center).add(new THREE.Vector3(0.3, 0.25, 1).normalize().multiplyScalar(distance));
+  camera.updateProjectionMatrix();
+  controls.target.copy(sphere.center);
+}
+
+function showStatus(text, isError = false) {
+  $('status').textContent = text;
+  $('status').classList.toggle('error', isError);
+}
+
+function describe(stats) {
+  const m = stats.model;
+  const kb = (viewer.bytesReceived / 1024).toFixed(0);
+  const total = viewer.bytesExpected ? ` of ${(viewer.bytesExpected / 1024).toFixed(0)}` : '';
+  const bpv = m && m.vertexCount ? ((8 * m.progress.bytesConsumed) / m.vertexCount).toFixed(1) : '–';
+  return `${kb}${total} KiB · level ${viewer.level} · ${viewer.vertexCount} vertices · ${viewer.triangleCount} triangles` +
+    (viewer.tetrahedronCount ? ` · ${viewer.tetrahedronCount} tetrahedra` : '') +
+    (viewer.edgeCount ? ` · ${viewer.edgeCount} edges` : '') + ` · ${bpv} bits/vertex so far`;
+}
+
+function start(load) {
+  controller?.abort();
+  if (current) {
+    scene.remove(current);
+    current.traverse((o) => { o.geometry?.dispose(); o.material?.dispose(); });
+  }
+  controller = new AbortController();
+  framed = false;
+  const began = performance.now();
+  Object.assign(viewer, { state: 'loading', refinements: 0, error: null, checksum: null, firstRenderMs: null, completeMs: null, bytesReceived: 0, levelsSeen: [] });
+  showStatus('loading…');
+  const options = {
+    signal: controller.signal,
+    onHeader(header) { viewer.bytesExpected = header.totalBytes; },
+    onProgress(stats) {
+      viewer.bytesReceived = stats.bytesReceived;
+      $('progress').value = stats.bytesExpected ? stats.bytesReceived / stats.bytesExpected : 0;
+    },
+    onRefine(group, stats) {
+      const m = stats.model;
+      Object.assign(viewer, {
+        refinements: stats.refinements, vertexCount: m.vertexCount, triangleCount: m.triangles.length / 3,
+        tetrahedronCount: m.tetrahedra.length / 4, edgeCount: m.edges.length / 2, pointCount: m.points.length,
+        level: m.progress.level,
+      });
+      if (!viewer.levelsSeen.includes(m.progress.level)) viewer.levelsSeen.push(m.progress.level);
+      if (viewer.firstRenderMs === null) viewer.firstRenderMs = performance.now() - began;
+      if (!framed) { frame(group); framed = true; }
+      if (m.complete) {
+        viewer.checksum = checksum(m);
+        viewer.completeMs = performance.now() - began;
+        viewer.state = 'complete';
+        $('progress').value = 1;
+      }
+      showStatus(describe(stats));
+    },
+  };
+  current = load(options);
+  scene.add(current);
+  current.userData.loaded.catch((error) => {
+    viewer.state = 'error';
+    viewer.error = error.code === 'aborted' ? 'stopped: showing the last level received' : error.message;
+    showStatus(viewer.error, error.code !== 'aborted');
+  });
+}
+
+function loadUrl(url, throttle) {
+  const full = throttle > 0 ? `${url}${url.includes('?') ? '&' : '?'}throttle=${throttle}` : url;
+  start((options) => loader.loadProgressive(full, options));
+}
+
+async function loadFile(file) {
+  let bytes = new Uint8Array(await file.arrayBuffer());
+  if (!file.name.toLowerCase().endsWith('.kdm')) {
+    showStatus(`encoding ${file.name} on the server…`);
+    const response = await fetch(`encode?name=${encodeURIComponent(file.name)}`, { method: 'POST', body: bytes });
+    if (!response.ok) {
+      viewer.state = 'error';
+      viewer.error = `cannot encode ${file.name}: ${await response.text()}`;
+      showStatus(viewer.error, true);
+      return;
+    }
+    bytes = new Uint8Array(await response.arrayBuffer());
+  }
+  start((options) => {
+    const group = loader.loadProgressive(URL.createObjectURL(new Blob([bytes])), options);
+    return group;
+  });
+}
+
+async function gallery() {
+  try {
+    const response = await fetch('models/');
+    return response.ok ? await response.json() : [];
+  } catch {
+    return [];
+  }
+}
+
+const params = new URLSearchParams(location.search);
+const throttle = Number(params.get('throttle') ?? 0);
+if (![...$('throttle').options].some((o) => o.value === String(throttle)))
+  $('throttle').add(new Option(`${throttle} kbit/s`, String(throttle)));
+$('throttle').value = String(throttle);
+const models = await gallery();
+for (const { name, bytes } of models) $('model').add(new Option(`${name} (${(bytes / 1024).toFixed(0)} KiB)`, name));
+const requested = params.get('model') ?? models[0]?.name;
+if (requested && !models.some((m) => m.name === requested)) $('model').add(new Option(requested, requested));
+if (requested) {
+  $('model').value = requested;
+  loadUrl(/^(https?:|\/|\.)/.test(requested) ? requested : `models/${encodeURIComponent(requested)}`, throttle);
+}
+
+$('model').addEventListener('change', () => loadUrl(`models/${encodeURIComponent($('model').value)}`, Number($('throttle').value)));
+$('throttle').addEventListener('change', () => $('model').value && loadUrl(`models/${encodeURIComponent($('model').value)}`, Number($('throttle').value)));
+$('stop').addEventListener('click', () => controller?.abort());
+$('file').addEventListener('change', () => $('file').files[0] && loadFile($('file').files[0]));
+const view = $('view');
+view.addEventListener('dragover', (e) => { e.preventDefault(); view.classList.add('dragging'); });
+view.addEventListener('dragleave', () => view.classList.remove('dragging'));
+view.addEventListener('drop', (e) => {
+  e.preventDefault();
+  view.classList.remove('dragging');
+  if (e.dataTransfer.files[0]) loadFile(e.dataTransfer.files[0]);
+});
