@@ -53,8 +53,8 @@ echo
 if [ "$quick" = 0 ]; then
   echo "Peak memory of the command-line tools on the dragon (12 bits, /usr/bin/time -v):"
   echo
-  /usr/bin/time -f "encode: %e s, %M KB peak" ./build-bench/kdmesh encode "$dragon" -o build-bench/dragon.kdm --bits 12 -q
-  /usr/bin/time -f "decode: %e s, %M KB peak" ./build-bench/kdmesh decode build-bench/dragon.kdm -o build-bench/dragon.ply -q
+  { /usr/bin/time -f "- encode: %e s, %M KB peak" ./build-bench/kdmesh encode "$dragon" -o build-bench/dragon.kdm --bits 12 -q; } 2>&1
+  { /usr/bin/time -f "- decode: %e s, %M KB peak" ./build-bench/kdmesh decode build-bench/dragon.kdm -o build-bench/dragon.ply -q; } 2>&1
   echo
 fi
 
