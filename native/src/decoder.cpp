@@ -91,16 +91,14 @@ struct Decoder::State {
     singleLevelEnd = singles.size();
     connectivity = header.maxDimension > 0;
     if (connectivity) {
-      store.reset(header.vertexCount, false);
+      // Vertex lists grow with the vertices actually decoded, not with the
+      // count a (possibly hostile) header announces.
+      store.reset(std::min<uint32_t>(header.vertexCount, 1024), false);
       const std::array<uint64_t, 4> caps = simplexCaps(header);
-      // Reserve what the header promises, but no more than a generous
-      // multiple of the bytes that could describe it, so that a hostile
-      // header cannot make the decoder reserve gigabytes up front.
-      const uint64_t plausible = 64 * header.bodyBytes + 1024;
-      for (int d = 1; d <= 3; ++d) {
-        const uint32_t cap = uint32_t(std::min<uint64_t>(caps[size_t(d)], 0xffffffffu));
-        store.setCapacity(d, cap, uint32_t(std::min<uint64_t>(cap, plausible)));
-      }
+      // Pools grow with the simplices actually decoded: nothing is reserved
+      // on the strength of the header's counts, which only cap the growth.
+      for (int d = 1; d <= 3; ++d)
+        store.setCapacity(d, uint32_t(std::min<uint64_t>(caps[size_t(d)], 0xffffffffu)), 0);
       splitter.emplace(store);
     }
     hasHeader = true;
@@ -166,6 +164,8 @@ struct Decoder::State {
     uint32_t added = cell.vertex;
     if (connectivity && !oneSided) {
       added = nextVertex++;
+      if (added >= store.vertexCapacity())
+        store.growVertices(std::min<uint32_t>(header.vertexCount, 2 * store.vertexCapacity()));
       parents.push_back(cell.vertex);
       const double before = coder.cost();
       if (!splitter->split(coder, cell.vertex, added, [] { return uint8_t(0); })) return false;

@@ -29,6 +29,11 @@ void SimplexStore::reset(uint32_t vertexCapacity, bool indexed) {
   }
 }
 
+void SimplexStore::growVertices(uint32_t count) {
+  for (int d = 1; d <= kMaxDimension; ++d)
+    if (heads_[d].size() < count) heads_[d].resize(count, kNoSimplex);
+}
+
 void SimplexStore::setCapacity(int dimension, uint32_t maxSimplices, uint32_t expected) {
   Pool& pool = pool_[dimension];
   pool.capacity = maxSimplices;

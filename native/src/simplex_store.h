@@ -40,6 +40,8 @@ class SimplexStore {
   // memory.
   void reset(uint32_t vertexCapacity, bool indexed);
   uint32_t vertexCapacity() const { return uint32_t(heads_[1].size()); }
+  // Makes room for vertex ids below `count` (lists start empty).
+  void growVertices(uint32_t count);
   // Pool sizes (live and killed) may not exceed `maxSimplices`; add()
   // reports kNoSimplex. Memory for `expected` simplices is reserved at once.
   void setCapacity(int dimension, uint32_t maxSimplices, uint32_t expected);

@@ -145,3 +145,29 @@ test('memory stays flat across 1,000 decode/dispose cycles', async () => {
   }
   assert.equal(await memoryInUse(), before);
 });
+
+function crc32(bytes) {
+  let crc = 0xffffffff;
+  for (const byte of bytes) {
+    crc ^= byte;
+    for (let k = 0; k < 8; ++k) crc = (crc >>> 1) ^ (0xedb88320 & -(crc & 1));
+  }
+  return (crc ^ 0xffffffff) >>> 0;
+}
+
+test('a hostile header announcing 10^8 vertices costs no memory up front', async () => {
+  const { bytes } = fixtures['torus-12'];
+  const hostile = Uint8Array.from(bytes.subarray(0, 140));
+  const view = new DataView(hostile.buffer);
+  view.setUint32(16, 100_000_000, true);        // vertex count
+  view.setUint32(28, 200_000_000, true);        // triangles
+  view.setBigUint64(80, 1n << 40n, true);       // body bytes
+  view.setUint32(92, crc32(hostile.subarray(0, 92)), true);
+  const before = await memoryInUse();
+  const decoder = await createDecoder();
+  decoder.push(hostile);
+  assert.equal(decoder.header.vertexCount, 100_000_000);
+  const grown = (await memoryInUse()) - before;
+  assert.ok(grown < 1 << 20, `heap grew by ${grown} bytes`);
+  decoder.dispose();
+});
