@@ -9,7 +9,7 @@ const $ = (id) => document.getElementById(id);
 const viewer = (window.kdmeshViewer = {
   state: 'idle', refinements: 0, vertexCount: 0, triangleCount: 0, tetrahedronCount: 0, edgeCount: 0,
   pointCount: 0, bytesReceived: 0, bytesExpected: 0, level: 0, error: null, checksum: null, firstRenderMs: null,
-  completeMs: null, levelsSeen: [],
+  completeMs: null, levelsSeen: [], longTasks: [],
   // Pixels of the last frame that differ from the background (for tests).
   modelPixels() {
     renderer.render(scene, camera);
@@ -26,6 +26,13 @@ const viewer = (window.kdmeshViewer = {
     return count;
   },
 });
+
+// Main-thread tasks over 50 ms (where the browser reports them).
+if (typeof PerformanceObserver === 'function' && PerformanceObserver.supportedEntryTypes?.includes('longtask')) {
+  new PerformanceObserver((list) => {
+    for (const entry of list.getEntries()) viewer.longTasks.push(Math.round(entry.duration));
+  }).observe({ type: 'longtask' });
+}
 
 const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
 renderer.setPixelRatio(Math.min(2, window.devicePixelRatio));
@@ -48,10 +55,20 @@ function resize() {
 }
 window.addEventListener('resize', resize);
 resize();
-renderer.setAnimationLoop(() => {
-  controls.update();
-  renderer.render(scene, camera);
-});
+// Frames are drawn on demand (camera moves, refinements, resizes): a
+// software-rendered page with a large model stays responsive.
+let frameRequested = false;
+function requestRender() {
+  if (frameRequested) return;
+  frameRequested = true;
+  requestAnimationFrame(() => {
+    frameRequested = false;
+    controls.update();
+    renderer.render(scene, camera);
+  });
+}
+controls.addEventListener('change', requestRender);
+window.addEventListener('resize', requestRender);
 
 const loader = new KDMeshLoader();
 let current = null;
@@ -105,7 +122,7 @@ function start(load) {
   controller = new AbortController();
   framed = false;
   const began = performance.now();
-  Object.assign(viewer, { state: 'loading', refinements: 0, error: null, checksum: null, firstRenderMs: null, completeMs: null, bytesReceived: 0, levelsSeen: [] });
+  Object.assign(viewer, { state: 'loading', refinements: 0, error: null, checksum: null, firstRenderMs: null, completeMs: null, bytesReceived: 0, levelsSeen: [], longTasks: [] });
   showStatus('loading…');
   const options = {
     signal: controller.signal,
@@ -131,6 +148,7 @@ function start(load) {
         $('progress').value = 1;
       }
       showStatus(describe(stats));
+      requestRender();
     },
   };
   current = load(options);
