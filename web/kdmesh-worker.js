@@ -13,7 +13,6 @@ let failed = false;
 let wanted = true;        // the page is ready for a snapshot
 let changed = false;      // chunks were applied since the last snapshot
 let headerSent = false;
-let queue = Promise.resolve();
 
 // Faces of the tetrahedra that belong to exactly one: the visible surface of
 // a tetrahedral mesh, oriented outwards when the tetrahedra are positive.
@@ -54,46 +53,68 @@ function fail(error) {
   decoder = null;
 }
 
-function handle(message) {
-  if (failed) return;
+// Received bytes wait here and are decoded one piece per task, so that the
+// page's 'next' requests are seen between pieces: the page gets refinements
+// while a fast download is still being decoded.
+const pending = [];
+let ending = false;
+let pumping = false;
+
+function pump() {
+  pumping = false;
+  if (failed || !decoder) return;
   try {
-    switch (message.type) {
-      case 'bytes': {
-        const before = decoder.progress.chunksApplied;
-        decoder.push(message.bytes);
-        if (!headerSent && decoder.header) {
-          headerSent = true;
-          postMessage({ type: 'header', header: decoder.header });
-        }
-        if (decoder.progress.chunksApplied !== before) changed = true;
-        sendSnapshot();
-        break;
+    if (pending.length) {
+      const before = decoder.progress.chunksApplied;
+      decoder.push(pending.shift());
+      if (!headerSent && decoder.header) {
+        headerSent = true;
+        postMessage({ type: 'header', header: decoder.header });
       }
-      case 'end':
-        decoder.finish();
-        sendSnapshot();
-        break;
-      case 'next':
-        wanted = true;
-        sendSnapshot();
-        break;
+      if (decoder.progress.chunksApplied !== before) changed = true;
+    } else if (ending) {
+      ending = false;
+      decoder.finish();
     }
+    sendSnapshot();
   } catch (error) {
     fail(error);
+    return;
   }
+  if (pending.length || ending) schedule();
+}
+
+function schedule() {
+  if (pumping) return;
+  pumping = true;
+  setTimeout(pump, 0);
 }
 
 onmessage = ({ data }) => {
-  if (data.type === 'start') {
-    queue = queue.then(async () => {
-      try {
-        if (data.wasmSource) setWasmSource(data.wasmSource);
-        decoder = await createDecoder(data.options ?? {});
-      } catch (error) {
-        fail(error);
-      }
-    });
-    return;
+  if (failed) return;
+  switch (data.type) {
+    case 'start':
+      (async () => {
+        try {
+          if (data.wasmSource) setWasmSource(data.wasmSource);
+          decoder = await createDecoder(data.options ?? {});
+          schedule();
+        } catch (error) {
+          fail(error);
+        }
+      })();
+      break;
+    case 'bytes':
+      pending.push(data.bytes);
+      if (decoder) schedule();
+      break;
+    case 'end':
+      ending = true;
+      if (decoder) schedule();
+      break;
+    case 'next':
+      wanted = true;
+      if (decoder) sendSnapshot();
+      break;
   }
-  queue = queue.then(() => handle(data));
 };
