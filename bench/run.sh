@@ -69,6 +69,13 @@ else
 fi
 echo
 
+if [ "$quick" = 0 ]; then
+  echo "## Viewer: time to first and final render (headless chromium, SwiftShader)"
+  echo
+  node bench/browser-bench.mjs --throttle 10000
+  echo
+fi
+
 echo "## Point clouds: file sizes from the command-line tools"
 echo
 echo "| model | bits | kdmesh bytes | kdmesh bpv | draco_encoder -point_cloud -cl 10 bytes | Draco bpv |"

@@ -2,7 +2,7 @@
 // and hands back snapshots as transferable arrays, one at a time, when the
 // page asks for the next one (so a fast network never floods the page).
 //
-// Messages in:  {type: 'start', wasmSource?}, {type: 'bytes', bytes},
+// Messages in:  {type: 'start', wasmSource?, tetrahedra?}, {type: 'bytes', bytes},
 //               {type: 'end'}, {type: 'next'} (the page is ready for a snapshot)
 // Messages out: {type: 'header', header}, {type: 'snapshot', model} (the
 //               last one has model.complete), {type: 'error', code, message}
@@ -13,6 +13,7 @@ let failed = false;
 let wanted = true;        // the page is ready for a snapshot
 let changed = false;      // chunks were applied since the last snapshot
 let headerSent = false;
+let wireframe = false;    // also send the edges of the tetrahedra
 
 // Faces of the tetrahedra that belong to exactly one: the visible surface of
 // a tetrahedral mesh, oriented outwards when the tetrahedra are positive.
@@ -33,16 +34,64 @@ function boundaryOfTetrahedra(tetrahedra) {
   return out;
 }
 
+// Area-weighted vertex normals of the triangles: computed here, off the
+// page's main thread, and sent with the snapshot.
+function vertexNormals(positions, triangleLists) {
+  const normals = new Float32Array(positions.length);
+  for (const triangles of triangleLists) {
+    for (let t = 0; t < triangles.length; t += 3) {
+      const a = 3 * triangles[t], b = 3 * triangles[t + 1], c = 3 * triangles[t + 2];
+      const ux = positions[b] - positions[a], uy = positions[b + 1] - positions[a + 1], uz = positions[b + 2] - positions[a + 2];
+      const vx = positions[c] - positions[a], vy = positions[c + 1] - positions[a + 1], vz = positions[c + 2] - positions[a + 2];
+      const nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = ux * vy - uy * vx;
+      for (const i of [a, b, c]) {
+        normals[i] += nx;
+        normals[i + 1] += ny;
+        normals[i + 2] += nz;
+      }
+    }
+  }
+  for (let i = 0; i < normals.length; i += 3) {
+    const length = Math.hypot(normals[i], normals[i + 1], normals[i + 2]) || 1;
+    normals[i] /= length;
+    normals[i + 1] /= length;
+    normals[i + 2] /= length;
+  }
+  return normals;
+}
+
+// Every edge of the tetrahedra once, for the wireframe view.
+function edgesOfTetrahedra(tetrahedra) {
+  const seen = new Set();
+  const out = [];
+  const pairs = [[0, 1], [0, 2], [0, 3], [1, 2], [1, 3], [2, 3]];
+  for (let t = 0; t < tetrahedra.length; t += 4) {
+    for (const [i, j] of pairs) {
+      const a = Math.min(tetrahedra[t + i], tetrahedra[t + j]), b = Math.max(tetrahedra[t + i], tetrahedra[t + j]);
+      const key = a * 4294967296 + b;
+      if (!seen.has(key)) {
+        seen.add(key);
+        out.push(a, b);
+      }
+    }
+  }
+  return Uint32Array.from(out);
+}
+
 function sendSnapshot() {
   if (!decoder || !wanted || !changed) return;
   const model = decoder.snapshot();
   model.boundary = model.tetrahedra.length ? boundaryOfTetrahedra(model.tetrahedra) : new Uint32Array(0);
+  model.tetrahedronEdges = model.tetrahedra.length && wireframe ? edgesOfTetrahedra(model.tetrahedra) : new Uint32Array(0);
+  const began = performance.now();
+  model.normals = vertexNormals(model.positions, [model.triangles, model.boundary]);
+  model.normalsMs = performance.now() - began;
   model.parents = decoder.parents();
   model.progress = decoder.progress;
   wanted = false;
   changed = false;
   const buffers = [model.positions, model.points, model.edges, model.triangles, model.tetrahedra, model.boundary,
-    model.parents].map((a) => a.buffer).filter((b, i, all) => b.byteLength && all.indexOf(b) === i);
+    model.tetrahedronEdges, model.normals, model.parents].map((a) => a.buffer).filter((b, i, all) => b.byteLength && all.indexOf(b) === i);
   postMessage({ type: 'snapshot', model }, buffers);
 }
 
@@ -97,6 +146,7 @@ onmessage = ({ data }) => {
       (async () => {
         try {
           if (data.wasmSource) setWasmSource(data.wasmSource);
+          wireframe = data.tetrahedra === 'wireframe';
           decoder = await createDecoder(data.options ?? {});
           schedule();
         } catch (error) {
