@@ -81,7 +81,8 @@ struct Decoder::State {
     return status;
   }
 
-  Status startBody() {
+  // `available`: bytes of the stream already at hand (those of this push).
+  Status startBody(size_t available) {
     schedule.emplace(header);
     dequantizer.emplace(header);
     counts.emplace(schedule->levels);
@@ -95,10 +96,15 @@ struct Decoder::State {
       // count a (possibly hostile) header announces.
       store.reset(std::min<uint32_t>(header.vertexCount, 1024), false);
       const std::array<uint64_t, 4> caps = simplexCaps(header);
-      // Pools grow with the simplices actually decoded: nothing is reserved
-      // on the strength of the header's counts, which only cap the growth.
-      for (int d = 1; d <= 3; ++d)
-        store.setCapacity(d, uint32_t(std::min<uint64_t>(caps[size_t(d)], 0xffffffffu)), 0);
+      // The header's counts cap the pools; memory is reserved up front only
+      // in proportion to the bytes already received (a whole file pushed at
+      // once reserves its final size; a hostile 100-byte header, next to
+      // nothing), and otherwise grows with the simplices actually decoded.
+      const uint64_t plausible = 16 * uint64_t(available);
+      for (int d = 1; d <= 3; ++d) {
+        const uint32_t cap = uint32_t(std::min<uint64_t>(caps[size_t(d)], 0xffffffffu));
+        store.setCapacity(d, cap, uint32_t(std::min<uint64_t>(cap, plausible)));
+      }
       splitter.emplace(store);
     }
     hasHeader = true;
@@ -274,7 +280,7 @@ struct Decoder::State {
       if (!hasHeader) {
         if (available < kHeaderBytes) break;
         status = readHeader(at, options.limits, header);
-        if (status.ok()) status = startBody();
+        if (status.ok()) status = startBody(available);
         offset += kHeaderBytes;
         bytesConsumed += kHeaderBytes;
         continue;
