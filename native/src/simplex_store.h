@@ -81,7 +81,9 @@ class SimplexStore {
     while (*link != kNoSimplex) {
       const uint32_t slot = *link;
       const uint32_t simplex = slot / arity;
-      if (!(pool.flags[simplex] & kAlive)) {
+      // Only the encoder's indexed store kills simplices; the decoder's walk
+      // need not load their flags.
+      if (indexed_ && !(pool.flags[simplex] & kAlive)) {
         *link = pool.next[slot];
         continue;
       }
