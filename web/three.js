@@ -83,7 +83,9 @@ export class KDMeshLoader extends Loader {
    * stats) after each refinement, onHeader(header), onProgress(stats),
    * signal (AbortSignal: stops the download and keeps the current level),
    * tetrahedra: 'boundary' (default: the faces in exactly one tetrahedron) or
-   * 'wireframe' (the boundary plus every edge of the tetrahedra).
+   * 'wireframe' (the boundary plus every edge of the tetrahedra), geomorph
+   * (true: new vertices glide from their parent's position over
+   * geomorphFrames frames, default 12; onAnimate(model) after each frame).
    */
   loadProgressive(url, options = {}) {
     const model = this.#start(options);
@@ -127,11 +129,47 @@ export class KDMeshLoader extends Loader {
       else settle.resolve(group);
     };
 
+    // Geomorphs: every vertex glides from where its ancestor was drawn at
+    // the previous level to its new position over a few frames. The three
+    // objects share one position attribute, so one update moves them all.
+    let previous = null;  // { positions, count } of the last level drawn
+    let morphId = 0;
+    const morph = (attribute, from, to, count) => {
+      const id = ++morphId;
+      const frames = options.geomorphFrames ?? 12;
+      let frame = 0;
+      const step = () => {
+        if (id !== morphId) return;
+        frame += 1;
+        const t = frame / frames;
+        const array = attribute.array;
+        for (let i = 0; i < 3 * count; ++i) array[i] = from[i] + t * (to[i] - from[i]);
+        attribute.needsUpdate = true;
+        options.onAnimate?.(group);
+        if (frame < frames) requestAnimationFrame(step);
+      };
+      requestAnimationFrame(step);
+    };
+
     const apply = (model) => {
       const capacity = stats.header?.vertexCount ?? model.vertexCount;
-      for (const object of [surface, lines, points]) {
-        updateAttribute(object.geometry, 'position', model.positions, 3, capacity);
+      let start = null;
+      if (options.geomorph && previous) {
+        start = new Float32Array(model.positions.length);
+        for (let v = 0; v < model.vertexCount; ++v) {
+          let ancestor = v;
+          while (ancestor >= previous.count) ancestor = model.parents[ancestor];
+          start[3 * v] = previous.positions[3 * ancestor];
+          start[3 * v + 1] = previous.positions[3 * ancestor + 1];
+          start[3 * v + 2] = previous.positions[3 * ancestor + 2];
+        }
       }
+      if (options.geomorph) previous = { positions: model.positions, count: model.vertexCount };
+      const position = updateAttribute(surface.geometry, 'position', start ?? model.positions, 3, capacity);
+      lines.geometry.setAttribute('position', position);
+      points.geometry.setAttribute('position', position);
+      if (start) morph(position, start, model.positions, model.vertexCount);
+      else morphId += 1;  // a level drawn at once ends any morph in flight
       const faces = model.tetrahedra.length
         ? (() => {
             const merged = new Uint32Array(model.triangles.length + model.boundary.length);

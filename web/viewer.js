@@ -10,6 +10,15 @@ const viewer = (window.kdmeshViewer = {
   state: 'idle', refinements: 0, vertexCount: 0, triangleCount: 0, tetrahedronCount: 0, edgeCount: 0,
   pointCount: 0, bytesReceived: 0, bytesExpected: 0, level: 0, error: null, checksum: null, firstRenderMs: null,
   completeMs: null, levelsSeen: [], longTasks: [],
+  // Whether the drawn positions are the last level's exactly (for tests:
+  // geomorphs must end where the model is).
+  drawnPositionsMatch() {
+    const model = current?.userData.stats.model;
+    const drawn = current?.children[0].geometry.getAttribute('position')?.array;
+    if (!model || !drawn) return false;
+    for (let i = 0; i < model.positions.length; ++i) if (drawn[i] !== model.positions[i]) return false;
+    return true;
+  },
   // Pixels of the last frame that differ from the background (for tests).
   modelPixels() {
     renderer.render(scene, camera);
@@ -126,6 +135,9 @@ function start(load) {
   showStatus('loading…');
   const options = {
     signal: controller.signal,
+    geomorph: $('geomorph').checked,
+    tetrahedra: $('wireframe').checked ? 'wireframe' : 'boundary',
+    onAnimate: requestRender,
     onHeader(header) { viewer.bytesExpected = header.totalBytes; },
     onProgress(stats) {
       viewer.bytesReceived = stats.bytesReceived;
@@ -194,6 +206,7 @@ async function gallery() {
 }
 
 const params = new URLSearchParams(location.search);
+$('geomorph').checked = params.get('geomorph') === '1';
 const throttle = Number(params.get('throttle') ?? 0);
 if (![...$('throttle').options].some((o) => o.value === String(throttle)))
   $('throttle').add(new Option(`${throttle} kbit/s`, String(throttle)));
@@ -210,6 +223,10 @@ if (requested) {
 $('model').addEventListener('change', () => loadUrl(`models/${encodeURIComponent($('model').value)}`, Number($('throttle').value)));
 $('throttle').addEventListener('change', () => $('model').value && loadUrl(`models/${encodeURIComponent($('model').value)}`, Number($('throttle').value)));
 $('stop').addEventListener('click', () => controller?.abort());
+const reload = () => $('model').value && loadUrl(`models/${encodeURIComponent($('model').value)}`, Number($('throttle').value));
+$('geomorph').addEventListener('change', reload);
+$('wireframe').addEventListener('change', reload);
+
 $('file').addEventListener('change', () => $('file').files[0] && loadFile($('file').files[0]));
 const view = $('view');
 view.addEventListener('dragover', (e) => { e.preventDefault(); view.classList.add('dragging'); });

@@ -101,3 +101,15 @@ test('stopping mid-stream keeps the coarse model on screen', async () => {
   assert.deepEqual(errors, []);
   await page.close();
 });
+
+test('geomorphs animate refinements and end exactly on the model', async () => {
+  execFileSync(cli, ['encode', join(root, 'build', 'models', 'ball10k.1.ele'), '-o', join(models, 'ball.kdm'), '--bits', '16', '-q']);
+  const { page, errors } = await openViewer('model=ball.kdm&throttle=300&geomorph=1');
+  await page.waitForFunction(() => window.kdmeshViewer.refinements >= 2, null, { timeout: 60000 });
+  await page.waitForFunction(() => window.kdmeshViewer.state === 'complete', null, { timeout: 60000 });
+  await page.waitForFunction(() => window.kdmeshViewer.drawnPositionsMatch(), null, { timeout: 10000 });
+  const state = await viewerState(page);
+  assert.ok(state.refinements >= 3, `refinements: ${state.refinements}`);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
