@@ -76,6 +76,33 @@ if [ "$quick" = 0 ]; then
   echo
 fi
 
+if [ "$quick" = 0 ]; then
+  echo "## Rate–distortion (docs/rate-distortion.svg)"
+  echo
+  rd=build-bench/rd
+  mkdir -p "$rd"
+  plot=""
+  for spec in "bunny:../shared/models/bunny.obj:12" "dragon:$dragon:12" "triceratops:build/models/triceratops.off:12" \
+              "tetrahedral-ball:build/models/ball10k.1.ele:16"; do
+    name=${spec%%:*}; rest=${spec#*:}; file=${rest%:*}; b=${rest##*:}
+    [ -f "$file" ] || continue
+    ./build-bench/kdmesh_bench_rd --bits "$b" "$file" > "$rd/$name.csv"
+    draco=""
+    case "$file" in *.ele) ;; *)
+      ./build-bench/kdmesh encode "$file" -o "$rd/$name.kdm" --exact -q
+      ./build-bench/kdmesh decode "$rd/$name.kdm" -o "$rd/$name.ply" -q
+      draco_encoder -i "$rd/$name.ply" -o "$rd/$name.drc" -qp "$b" -cl 10 >/dev/null
+      draco=":$(wc -c < "$rd/$name.drc")" ;;
+    esac
+    plot="$plot $name-${b}bit=$rd/$name.csv$draco"
+    echo "- $name ($b bits): $(sed -n 2p "$rd/$name.csv" | cut -d, -f2) vertex after $(sed -n 2p "$rd/$name.csv" | cut -d, -f1) bytes;" \
+      "mean error 1 % of the diagonal after $(awk -F, 'NR > 1 && $3 <= 0.01 { print $1; exit }' "$rd/$name.csv") bytes of $(tail -n 1 "$rd/$name.csv" | cut -d, -f1)"
+  done
+  # shellcheck disable=SC2086
+  node bench/plot-rd.mjs docs/rate-distortion.svg $plot
+  echo
+fi
+
 echo "## Point clouds: file sizes from the command-line tools"
 echo
 echo "| model | bits | kdmesh bytes | kdmesh bpv | draco_encoder -point_cloud -cl 10 bytes | Draco bpv |"

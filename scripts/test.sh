@@ -7,3 +7,6 @@ sh scripts/build.sh
 sh scripts/models.sh
 ctest --test-dir build --output-on-failure -j"$(nproc)"
 node --test tests/js/ tests/browser/
+# The benchmark suite's smoke run: CI checks only that it runs.
+sh bench/run.sh --quick > build/bench-quick.md
+test -s build/bench-quick.md
