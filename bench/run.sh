@@ -103,6 +103,15 @@ if [ "$quick" = 0 ]; then
   echo
 fi
 
+if [ "$quick" = 0 ]; then
+  echo "## Scale: the dragon replicated side by side (16 bits, one run each)"
+  echo
+  echo "| copies | triangles | bytes | encode s | decode s | encode Mtri/s | decode Mtri/s | peak bytes / triangle |"
+  echo "|---:|---:|---:|---:|---:|---:|---:|---:|"
+  for copies in 1 2 4 6; do ./build-bench/kdmesh_bench_scale "$copies" "$dragon"; done
+  echo
+fi
+
 echo "## Point clouds: file sizes from the command-line tools"
 echo
 echo "| model | bits | kdmesh bytes | kdmesh bpv | draco_encoder -point_cloud -cl 10 bytes | Draco bpv |"
