@@ -3,7 +3,7 @@
 # missing packages are installed, so repeated runs cost a dpkg query.
 set -eu
 
-APT_PACKAGES="cmake g++ make libgtest-dev libcli11-dev libbenchmark-dev draco libdraco-dev libcgal-demo time emscripten tetgen chromium"
+APT_PACKAGES="cmake g++ make libgtest-dev libcli11-dev libbenchmark-dev draco libdraco-dev libcgal-demo time emscripten tetgen chromium clang"
 
 missing=""
 for pkg in $APT_PACKAGES; do
