@@ -10,3 +10,6 @@ node --test tests/js/ tests/browser/
 # The benchmark suite's smoke run: CI checks only that it runs.
 sh bench/run.sh --quick > build/bench-quick.md
 test -s build/bench-quick.md
+# Robustness: the suite under ASan + UBSan, and a short fuzzing run.
+sh scripts/sanitize.sh
+sh scripts/fuzz.sh 25
