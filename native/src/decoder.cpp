@@ -31,6 +31,14 @@ struct Cell {
   uint32_t vertex;  // id in the complex (connectivity streams only)
 };
 
+// Every split codes at least one binary decision, and a decision costs at
+// least -log2(1 - 31/32768) = 0.00137 bits (models never go closer to
+// certainty), so a chunk can hold at most ~5,860 splits per byte of payload
+// (plus the few zero bytes the range decoder reads past its end). A frame
+// that claims more is corrupt; refusing it bounds the work a chunk can ask for
+// by its size.
+constexpr uint64_t kMaxSplitsPerByte = 6000;
+
 }  // namespace
 
 struct Decoder::State {
@@ -295,7 +303,7 @@ struct Decoder::State {
       const ChunkFrame frame = readChunkFrame(at);
       const uint64_t end = bytesConsumed + kChunkFrameBytes + uint64_t(frame.payloadBytes);
       if (frame.payloadBytes > options.limits.maxChunkBytes || end > header.totalBytes() ||
-          frame.splitCount == 0) {
+          frame.splitCount == 0 || frame.splitCount > kMaxSplitsPerByte * (uint64_t(frame.payloadBytes) + 8)) {
         status = Status::error(ErrorCode::CorruptChunk,
                                "chunk " + std::to_string(chunks.size()) + ": invalid frame");
         break;

@@ -219,5 +219,16 @@ TEST(Stream, ChunkFramesLargerThanTheLimitAreRefusedEarly) {
   EXPECT_EQ(d.push(bytes.data(), kHeaderBytes + kChunkFrameBytes).code, ErrorCode::CorruptChunk);
 }
 
+// The frame's split count is not under the payload checksum: a count that no
+// payload of that size can hold is refused before any work.
+TEST(Stream, ChunkFramesClaimingMoreSplitsThanTheirBytesCanCodeAreRefused) {
+  std::vector<uint8_t> bytes = sphereStream(100, 256);
+  ChunkFrame frame = readChunkFrame(bytes.data() + kHeaderBytes);
+  frame.splitCount = 0xffffffffu;
+  writeChunkFrame(frame, bytes.data() + kHeaderBytes);
+  Decoder d;
+  EXPECT_EQ(d.push(bytes.data(), kHeaderBytes + kChunkFrameBytes).code, ErrorCode::CorruptChunk);
+}
+
 }  // namespace
 }  // namespace kdmesh::test
