@@ -16,7 +16,10 @@ TextScanner::TextScanner(const uint8_t* data, size_t size, TextSyntax syntax)
       cursor_(begin_),
       lineEnd_(begin_),
       next_(begin_),
-      syntax_(syntax) {}
+      syntax_(syntax) {
+  // Editors on some systems start text files with a UTF-8 byte order mark.
+  if (size >= 3 && std::memcmp(begin_, "\xEF\xBB\xBF", 3) == 0) cursor_ = lineEnd_ = next_ = begin_ + 3;
+}
 
 bool TextScanner::nextLine() {
   if (next_ == end_) {

@@ -1,0 +1,103 @@
+// Odd and hostile inputs for the readers and the encoder: each gets a clear
+// error or a correct result (ctest gives every test a time limit).
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "complexes.h"
+#include "kdmesh/io.h"
+#include "kdmesh/kdmesh.h"
+#include "shapes.h"
+#include "test_support.h"
+
+namespace kdmesh::test {
+namespace {
+
+Status readText(io::Format format, const std::string& text, Complex& out) {
+  io::Notes notes;
+  return io::readMemory(format, reinterpret_cast<const uint8_t*>(text.data()), text.size(), out, notes);
+}
+
+TEST(HostileInputs, ByteOrderMarksAreSkipped) {
+  Complex c;
+  ASSERT_TRUE(readText(io::Format::Obj, "\xEF\xBB\xBFv 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nf 1 2 3\r\n", c).ok());
+  EXPECT_EQ(c.simplexCount(2), 1u);
+  ASSERT_TRUE(readText(io::Format::Xyz, "\xEF\xBB\xBF" "1 2 3\n", c).ok());
+  EXPECT_EQ(c.vertexCount(), 1u);
+}
+
+TEST(HostileInputs, HugeObjLinesAndNegativeIndicesOutOfRange) {
+  Complex c;
+  std::string line = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf";
+  for (int i = 0; i < 200000; ++i) line += " 1 2 3";
+  line += "\n";
+  EXPECT_TRUE(readText(io::Format::Obj, line, c).ok());  // a huge polygon, fan-split
+  const Status s = readText(io::Format::Obj, "v 0 0 0\nf -1 -2 -3\n", c);
+  EXPECT_FALSE(s.ok());
+  EXPECT_NE(s.message.find("line 2"), std::string::npos) << s.message;
+}
+
+TEST(HostileInputs, NegativeAndHugeCountsInHeaders) {
+  Complex c;
+  EXPECT_FALSE(readText(io::Format::Off, "OFF\n-3 1 0\n", c).ok());
+  EXPECT_FALSE(readText(io::Format::Off, "OFF\n2147483648 1 0\n0 0 0\n", c).ok());
+  EXPECT_FALSE(readText(io::Format::Ply, "ply\nformat ascii 1.0\nelement vertex -1\nproperty float x\nend_header\n", c).ok());
+}
+
+TEST(HostileInputs, ASingleTriangleRoundTrips) {
+  Complex c;
+  c.positions = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  c.triangles = {0, 2, 1};
+  EncodeOptions o;
+  o.exact = true;
+  const EncodeResult r = encode(c, o);
+  ASSERT_TRUE(r.status.ok());
+  Complex d;
+  ASSERT_TRUE(decode(r.bytes.data(), r.bytes.size(), d).ok());
+  EXPECT_EQ(canonicalForm(d), canonicalForm(c));
+}
+
+TEST(HostileInputs, AMillionCoincidentVertices) {
+  Complex cloud;
+  cloud.positions.assign(3 * 1000000, 0.5f);
+  const EncodeResult r = encode(cloud, EncodeOptions{});
+  ASSERT_TRUE(r.status.ok());
+  EXPECT_LT(r.bytes.size(), 2048u);  // nothing to say but the count
+  Complex d;
+  ASSERT_TRUE(decode(r.bytes.data(), r.bytes.size(), d).ok());
+  EXPECT_EQ(d.vertexCount(), 1000000u);
+  // With connectivity, coincident vertices are told apart by their simplices.
+  Complex fan;
+  fan.positions.assign(3 * 20001, 1.f);
+  for (uint32_t i = 1; i + 1 < 20001; i += 2) fan.triangles.insert(fan.triangles.end(), {0, i, i + 1});
+  const EncodeResult f = encode(fan, EncodeOptions{});
+  ASSERT_TRUE(f.status.ok()) << f.status.message;
+  ASSERT_TRUE(decode(f.bytes.data(), f.bytes.size(), d).ok());
+  EXPECT_EQ(d.simplexCount(2), 10000u);
+  EXPECT_EQ(canonicalForm(d).size(), canonicalForm(fan).size());
+}
+
+TEST(HostileInputs, TenMillionPoints) {
+  Complex cloud;
+  cloud.positions = uniformCloud(10000000, 77);
+  EncodeOptions o;
+  o.bits = 12;
+  const EncodeResult r = encode(cloud, o);
+  ASSERT_TRUE(r.status.ok());
+  Complex d;
+  ASSERT_TRUE(decode(r.bytes.data(), r.bytes.size(), d).ok());
+  EXPECT_EQ(d.vertexCount(), 10000000u);
+}
+
+TEST(HostileInputs, ZeroVerticesAndOutOfRangeIndicesAreErrors) {
+  EXPECT_EQ(encode(Complex{}, EncodeOptions{}).status.code, ErrorCode::InvalidInput);
+  Complex c;
+  c.positions = {0, 0, 0};
+  c.tetrahedra = {0, 0, 0, 4000000000u};
+  const EncodeResult r = encode(c, EncodeOptions{});
+  EXPECT_EQ(r.status.code, ErrorCode::InvalidInput);
+  EXPECT_NE(r.status.message.find("tetrahedron 0"), std::string::npos) << r.status.message;
+}
+
+}  // namespace
+}  // namespace kdmesh::test
