@@ -87,7 +87,7 @@ test('a corrupted file shows a readable error and throws nothing uncaught', asyn
   await page.close();
 });
 
-test('stopping mid-stream keeps the coarse model on screen', async () => {
+test('stopping mid-stream keeps the coarse model on screen, and loading again works', async () => {
   const { page, errors } = await openViewer('model=dragon.kdm&throttle=400');
   await page.waitForFunction(() => window.kdmeshViewer.refinements >= 1, null, { timeout: 60000 });
   await page.click('#stop');
@@ -98,6 +98,9 @@ test('stopping mid-stream keeps the coarse model on screen', async () => {
   const pixels = await page.evaluate(() => window.kdmeshViewer.modelPixels());
   assert.ok(pixels > 100, `pixels after stopping: ${pixels}`);
   await page.screenshot({ path: join(screenshots, 'dragon-stopped.png') });
+  // Retry: the same model again, unthrottled, completes.
+  await page.selectOption('#throttle', '0');
+  await page.waitForFunction(() => window.kdmeshViewer.state === 'complete', null, { timeout: 120000 });
   assert.deepEqual(errors, []);
   await page.close();
 });
