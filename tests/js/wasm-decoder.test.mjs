@@ -171,3 +171,21 @@ test('a hostile header announcing 10^8 vertices costs no memory up front', async
   assert.ok(grown < 1 << 20, `heap grew by ${grown} bytes`);
   decoder.dispose();
 });
+
+test('a download that drops mid-chunk keeps the last whole chunk, reports truncation, and a retry completes', async () => {
+  const { bytes } = fixtures['torus-12'];
+  const decoder = await createDecoder();
+  const cut = Math.floor(bytes.length * 0.6);
+  decoder.push(bytes.subarray(0, cut));
+  const { bytesConsumed, chunksApplied } = decoder.progress;
+  assert.ok(bytesConsumed < cut && chunksApplied > 0, 'the cut falls inside a chunk');
+  const lastGood = decoder.snapshot();
+  assert.throws(() => decoder.finish(), (e) => e.code === 'truncated');
+  const atBoundary = await createDecoder();
+  atBoundary.push(bytes.subarray(0, bytesConsumed));
+  assert.deepEqual(lastGood, atBoundary.snapshot());
+  atBoundary.dispose();
+  decoder.dispose();
+  const retry = await decode(bytes);
+  assert.equal(retry.complete, true);
+});

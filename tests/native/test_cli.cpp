@@ -387,5 +387,19 @@ TEST_F(CliTest, BadOptionsFailWithOneLine) {
   EXPECT_EQ(readModel("cloud.xyz").vertexCount(), 100u);
 }
 
+// File names are bytes: a name that is not UTF-8 (here with 0xFF and a
+// space) must work as input and output, and appear in error messages as is.
+TEST_F(CliTest, FileNamesThatAreNotUtf8Work) {
+  const std::string input = "cloud \xff.xyz", output = "out \xfe.kdm", decoded = "back \xfd.xyz";
+  Complex c;
+  c.positions = {0.5f, 1.f, 2.f, -3.f, 4.f, 5.25f};
+  writeModel(input, c);
+  runOk("encode '" + input + "' -o '" + output + "' --exact -q");
+  runOk("decode '" + output + "' -o '" + decoded + "' -q");
+  EXPECT_EQ(readModel(decoded).positions.size(), 6u);
+  const std::string line = expectError("encode 'missing \xff.obj' -o x.kdm");
+  EXPECT_NE(line.find("\xff"), std::string::npos) << line;
+}
+
 }  // namespace
 }  // namespace kdmesh::test
