@@ -78,11 +78,15 @@ test('the dragon streams through a throttled route, refines at least 5 times and
   await page.close();
 });
 
-test('a corrupted file shows a readable error and throws nothing uncaught', async () => {
+test('a corrupted file shows a readable error, keeps the last good level and throws nothing uncaught', async () => {
   const { page, errors } = await openViewer('model=corrupt.kdm');
   await page.waitForFunction(() => window.kdmeshViewer.state === 'error', null, { timeout: 60000 });
   const status = await page.textContent('#status');
   assert.match(status, /checksum|corrupt|undecodable/i);
+  // The levels decoded before the corrupt chunk stay on screen.
+  const state = await viewerState(page);
+  assert.ok(state.vertexCount > 0, 'a coarse model was shown before the error');
+  assert.ok(await page.evaluate(() => window.kdmeshViewer.modelPixels()) > 100);
   assert.deepEqual(errors, []);
   await page.close();
 });
