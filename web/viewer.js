@@ -10,6 +10,8 @@ const viewer = (window.kdmeshViewer = {
   state: 'idle', refinements: 0, vertexCount: 0, triangleCount: 0, tetrahedronCount: 0, edgeCount: 0,
   pointCount: 0, bytesReceived: 0, bytesExpected: 0, level: 0, error: null, checksum: null, firstRenderMs: null,
   completeMs: null, levelsSeen: [], longTasks: [],
+  // Decoding workers still running (0 once a load has ended, however).
+  activeWorkers: () => loader.workers.size,
   // Whether the drawn positions are the last level's exactly (for tests:
   // geomorphs must end where the model is).
   drawnPositionsMatch() {

@@ -87,6 +87,7 @@ test('a corrupted file shows a readable error, keeps the last good level and thr
   const state = await viewerState(page);
   assert.ok(state.vertexCount > 0, 'a coarse model was shown before the error');
   assert.ok(await page.evaluate(() => window.kdmeshViewer.modelPixels()) > 100);
+  assert.equal(await page.evaluate(() => window.kdmeshViewer.activeWorkers()), 0, 'the worker is freed');
   assert.deepEqual(errors, []);
   await page.close();
 });
@@ -99,6 +100,7 @@ test('stopping mid-stream keeps the coarse model on screen, and loading again wo
   const state = await viewerState(page);
   assert.match(state.error, /stopped/);
   assert.ok(state.vertexCount > 0);
+  assert.equal(await page.evaluate(() => window.kdmeshViewer.activeWorkers()), 0, 'the worker is freed');
   const pixels = await page.evaluate(() => window.kdmeshViewer.modelPixels());
   assert.ok(pixels > 100, `pixels after stopping: ${pixels}`);
   await page.screenshot({ path: join(screenshots, 'dragon-stopped.png') });
