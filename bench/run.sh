@@ -51,10 +51,20 @@ fi
 ./build-bench/kdmesh_bench_mesh --runs "$runs" $bits $meshes
 echo
 if [ "$quick" = 0 ]; then
-  echo "Peak memory of the command-line tools on the dragon (12 bits, /usr/bin/time -v):"
+  echo "Peak memory of the command-line tools (12 bits; fandisk 10; the tetrahedral ball 16):"
   echo
-  { /usr/bin/time -f "- encode: %e s, %M KB peak" ./build-bench/kdmesh encode "$dragon" -o build-bench/dragon.kdm --bits 12 -q; } 2>&1
-  { /usr/bin/time -f "- decode: %e s, %M KB peak" ./build-bench/kdmesh decode build-bench/dragon.kdm -o build-bench/dragon.ply -q; } 2>&1
+  echo "| model | triangles + tetrahedra | encode s | encode peak KB | bytes/simplex | decode s | decode peak KB | bytes/simplex |"
+  echo "|---|---:|---:|---:|---:|---:|---:|---:|"
+  for spec in "build/models/triceratops.off:12" "build/models/fandisk.off:10" "../shared/models/bunny.obj:12" \
+              "$dragon:12" "build/models/ball10k.1.ele:16"; do
+    file=${spec%:*}; b=${spec##*:}
+    [ -f "$file" ] || continue
+    enc=$( { /usr/bin/time -f "%e %M" ./build-bench/kdmesh encode "$file" -o build-bench/peak.kdm --bits "$b" -q; } 2>&1 | tail -n 1)
+    dec=$( { /usr/bin/time -f "%e %M" ./build-bench/kdmesh decode build-bench/peak.kdm -o build-bench/peak.ply -q; } 2>&1 | tail -n 1)
+    simplices=$(./build-bench/kdmesh info build-bench/peak.kdm --json | awk -F'[][,]' '/simplexCounts/ { print $4 + $5 }')
+    echo "$(basename "$file") $simplices $enc $dec" |
+      awk '{ printf "| %s | %d | %.2f | %d | %.0f | %.2f | %d | %.0f |\n", $1, $2, $3, $4, 1024 * $4 / $2, $5, $6, 1024 * $6 / $2 }'
+  done
   echo
 fi
 
