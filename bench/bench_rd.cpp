@@ -1,17 +1,120 @@
 // Rate–distortion of progressive decoding: for prefixes of a stream, how far
 // each vertex of the complete model is from the vertex that stands for it at
-// that prefix (its ancestor, through the decoder's stable vertex ids),
-// relative to the bounding-box diagonal.
+// that prefix (its ancestor, through the decoder's stable vertex ids), and
+// the symmetric Hausdorff distance between the prefix's and the complete
+// model's surfaces, estimated from 50,000 area-weighted samples of each
+// surface plus its vertices (so it over-estimates by up to the sample
+// spacing); all relative to the bounding-box diagonal.
 //
 //   kdmesh_bench_rd [--bits B] [--points N] MODEL
 //
-// Prints CSV: bytes,vertices,mean_error,max_error (errors / diagonal).
+// Prints CSV: bytes,vertices,mean_error,max_error,hausdorff (hausdorff is
+// empty for models without triangles).
 #include <cmath>
 #include <cstdio>
+#include <random>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
+#include <algorithm>
+#include <array>
+
 #include "bench_common.h"
+
+namespace {
+
+using Point = std::array<double, 3>;
+
+// The vertices plus `count` points on the triangles, area-weighted.
+std::vector<Point> surfaceSamples(const kdmesh::Complex& c, size_t count, uint32_t seed) {
+  std::vector<Point> out;
+  for (size_t v = 0; v < c.vertexCount(); ++v)
+    out.push_back({c.positions[3 * v], c.positions[3 * v + 1], c.positions[3 * v + 2]});
+  const size_t triangles = c.triangles.size() / 3;
+  std::vector<double> cumulative(triangles);
+  double total = 0;
+  auto corner = [&](size_t t, int k) {
+    const size_t v = c.triangles[3 * t + size_t(k)];
+    return Point{c.positions[3 * v], c.positions[3 * v + 1], c.positions[3 * v + 2]};
+  };
+  for (size_t t = 0; t < triangles; ++t) {
+    const Point a = corner(t, 0), b = corner(t, 1), d = corner(t, 2);
+    const double u[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, w[3] = {d[0] - a[0], d[1] - a[1], d[2] - a[2]};
+    const double n[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+    total += 0.5 * std::sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+    cumulative[t] = total;
+  }
+  if (triangles == 0 || total <= 0) return out;
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> uniform(0, 1);
+  for (size_t i = 0; i < count; ++i) {
+    const size_t t = size_t(std::lower_bound(cumulative.begin(), cumulative.end(), uniform(rng) * total) - cumulative.begin());
+    double r1 = uniform(rng), r2 = uniform(rng);
+    if (r1 + r2 > 1) r1 = 1 - r1, r2 = 1 - r2;
+    const Point a = corner(std::min(t, triangles - 1), 0), b = corner(std::min(t, triangles - 1), 1),
+                d = corner(std::min(t, triangles - 1), 2);
+    out.push_back({a[0] + r1 * (b[0] - a[0]) + r2 * (d[0] - a[0]), a[1] + r1 * (b[1] - a[1]) + r2 * (d[1] - a[1]),
+                   a[2] + r1 * (b[2] - a[2]) + r2 * (d[2] - a[2])});
+  }
+  return out;
+}
+
+// Nearest-point queries on a point set through a hash grid searched in
+// growing rings of cells.
+class NearestPoint {
+ public:
+  NearestPoint(const std::vector<Point>& points, double cell) : points_(points), cell_(cell) {
+    for (size_t i = 0; i < points.size(); ++i) grid_[key(cellOf(points[i]))].push_back(uint32_t(i));
+  }
+
+  double distance(const Point& p) const {
+    double best = INFINITY;
+    if (points_.size() < 4096) {  // few points (coarse prefixes): far apart, no grid
+      for (const Point& q : points_)
+        best = std::min(best, std::sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
+                                        (p[2] - q[2]) * (p[2] - q[2])));
+      return best;
+    }
+    const std::array<int64_t, 3> c = cellOf(p);
+    for (int64_t ring = 0; ring < 4096; ++ring) {
+      for (int64_t dx = -ring; dx <= ring; ++dx)
+        for (int64_t dy = -ring; dy <= ring; ++dy)
+          for (int64_t dz = -ring; dz <= ring; ++dz) {
+            if (std::max({std::llabs(dx), std::llabs(dy), std::llabs(dz)}) != ring) continue;
+            const auto found = grid_.find(key({c[0] + dx, c[1] + dy, c[2] + dz}));
+            if (found == grid_.end()) continue;
+            for (const uint32_t i : found->second) {
+              const Point& q = points_[i];
+              best = std::min(best, std::sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
+                                              (p[2] - q[2]) * (p[2] - q[2])));
+            }
+          }
+      // Cells beyond this ring are at least ring * cell away.
+      if (best <= double(ring) * cell_) break;
+    }
+    return best;
+  }
+
+ private:
+  std::array<int64_t, 3> cellOf(const Point& p) const {
+    return {int64_t(std::floor(p[0] / cell_)), int64_t(std::floor(p[1] / cell_)), int64_t(std::floor(p[2] / cell_))};
+  }
+  static uint64_t key(const std::array<int64_t, 3>& c) {
+    return uint64_t(c[0] * 73856093) ^ uint64_t(c[1] * 19349663) ^ uint64_t(c[2] * 83492791);
+  }
+  const std::vector<Point>& points_;
+  double cell_;
+  std::unordered_map<uint64_t, std::vector<uint32_t>> grid_;
+};
+
+double directedHausdorff(const std::vector<Point>& from, const NearestPoint& to) {
+  double worst = 0;
+  for (const Point& p : from) worst = std::max(worst, to.distance(p));
+  return worst;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
   int bits = 12, samples = 40;
@@ -46,7 +149,13 @@ int main(int argc, char** argv) {
   const double diagonal = std::sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                                     (hi[2] - lo[2]) * (hi[2] - lo[2]));
 
-  std::printf("bytes,vertices,mean_error,max_error\n");
+  const bool surfaces = !final.triangles.empty();
+  const size_t kSamples = 50000;
+  const std::vector<Point> finalSamples = surfaces ? surfaceSamples(final, kSamples, 1) : std::vector<Point>{};
+  const double cell = diagonal / 256;
+  const NearestPoint nearFinal(finalSamples, cell);
+
+  std::printf("bytes,vertices,mean_error,max_error,hausdorff\n");
   const double first = double(kdmesh::kHeaderBytes + kdmesh::kChunkFrameBytes + 16), last = double(bytes.size());
   for (int s = 0; s < samples; ++s) {
     const size_t cut = size_t(std::llround(first * std::pow(last / first, double(s) / (samples - 1))));
@@ -68,7 +177,16 @@ int main(int argc, char** argv) {
       sum += d;
       worst = std::max(worst, d);
     }
-    std::printf("%zu,%u,%.6g,%.6g\n", cut, count, sum / double(n) / diagonal, worst / diagonal);
+    std::string hausdorff;
+    if (surfaces) {
+      const std::vector<Point> prefixSamples = surfaceSamples(prefix, kSamples, 2);
+      const NearestPoint nearPrefix(prefixSamples, cell);
+      const double h = std::max(directedHausdorff(prefixSamples, nearFinal), directedHausdorff(finalSamples, nearPrefix));
+      char text[32];
+      std::snprintf(text, sizeof text, "%.6g", h / diagonal);
+      hausdorff = text;
+    }
+    std::printf("%zu,%u,%.6g,%.6g,%s\n", cut, count, sum / double(n) / diagonal, worst / diagonal, hausdorff.c_str());
   }
   return 0;
 }

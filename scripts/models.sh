@@ -37,3 +37,9 @@ if [ ! -f build/models/ball10k.1.ele ]; then
   '
   tetgen -Q build/models/ball10k.node >/dev/null
 fi
+
+# A tetrahedralized solid: TetGen's quality mesh (-pq) of the closed fandisk.
+if [ ! -f build/models/fandisk-solid.1.ele ]; then
+  cp build/models/fandisk.off build/models/fandisk-solid.off
+  tetgen -pqQ build/models/fandisk-solid.off >/dev/null
+fi
