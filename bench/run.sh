@@ -44,7 +44,7 @@ echo
 meshes="build/models/triceratops.off"
 if [ "$quick" = 0 ]; then
   meshes="$meshes $(ls ../shared/models/bunny.obj 2>/dev/null || true) $dragon"
-  ./build-bench/kdmesh_bench_mesh --runs "$runs" --bits 10 build/models/fandisk.off
+  ./build-bench/kdmesh_bench_mesh --runs "$runs" --bits 10 --bits 16 build/models/fandisk.off
   echo
 fi
 # shellcheck disable=SC2086
