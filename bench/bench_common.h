@@ -45,6 +45,13 @@ inline std::string baseName(const std::string& path) {
   return slash == std::string::npos ? path : path.substr(slash + 1);
 }
 
+// One codec on one model: stream size and warm median times.
+struct Measurement {
+  size_t bytes = 0;
+  double encodeSeconds = 0;
+  double decodeSeconds = 0;
+};
+
 struct Arguments {
   int runs = 7;
   std::vector<int> bits;

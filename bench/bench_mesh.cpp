@@ -12,9 +12,8 @@
 #include <vector>
 
 #include "bench_common.h"
+#include "bench_draco.h"
 #include "crc32.h"
-#include "draco/compression/decode.h"
-#include "draco/compression/encode.h"
 #include "draco/mesh/triangle_soup_mesh_builder.h"
 
 namespace {
@@ -22,10 +21,7 @@ namespace {
 using bench::fail;
 using bench::medianSeconds;
 
-struct Measurement {
-  size_t bytes = 0;
-  double encodeSeconds = 0, decodeSeconds = 0;
-};
+using bench::Measurement;
 
 // The mesh as Draco's own OBJ/PLY loaders build it: a soup of corners whose
 // equal positions are merged.
@@ -43,26 +39,8 @@ std::unique_ptr<draco::Mesh> dracoMesh(const kdmesh::Complex& complex) {
 }
 
 Measurement measureDraco(const draco::Mesh& mesh, int bits, int level, int runs, size_t triangles) {
-  draco::Encoder encoder;
-  encoder.SetAttributeQuantization(draco::GeometryAttribute::POSITION, bits);
-  encoder.SetSpeedOptions(10 - level, 10 - level);
-  draco::EncoderBuffer buffer;
-  Measurement m;
-  m.encodeSeconds = medianSeconds(runs, [&] {
-    buffer.Clear();
-    const draco::Status status = encoder.EncodeMeshToBuffer(mesh, &buffer);
-    if (!status.ok()) fail("draco encode: " + status.error_msg_string());
-  });
-  m.bytes = buffer.size();
   size_t faces = 0;
-  m.decodeSeconds = medianSeconds(runs, [&] {
-    draco::DecoderBuffer input;
-    input.Init(buffer.data(), buffer.size());
-    draco::Decoder decoder;
-    auto decoded = decoder.DecodeMeshFromBuffer(&input);
-    if (!decoded.ok()) fail("draco decode: " + decoded.status().error_msg_string());
-    faces = decoded.value()->num_faces();
-  });
+  const Measurement m = bench::measureDraco(mesh, bits, level, runs, faces);
   if (faces == 0) fail("draco decoded no triangles");
   if (faces != triangles)
     std::fprintf(stderr, "note: draco -cl %d kept %zu of %zu triangles (it drops degenerate ones)\n", level,

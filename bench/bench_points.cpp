@@ -11,8 +11,7 @@
 #include <vector>
 
 #include "bench_common.h"
-#include "draco/compression/decode.h"
-#include "draco/compression/encode.h"
+#include "bench_draco.h"
 #include "draco/point_cloud/point_cloud_builder.h"
 
 namespace {
@@ -20,11 +19,7 @@ namespace {
 using bench::fail;
 using bench::medianSeconds;
 
-struct Measurement {
-  size_t bytes = 0;
-  double encodeSeconds = 0;
-  double decodeSeconds = 0;
-};
+using bench::Measurement;
 
 Measurement measureKdmesh(const kdmesh::Complex& cloud, int bits, int runs) {
   kdmesh::EncodeOptions options;
@@ -54,30 +49,9 @@ std::unique_ptr<draco::PointCloud> dracoCloud(const std::vector<float>& position
   return builder.Finalize(/*deduplicate_points=*/false);
 }
 
-// compressionLevel as draco_encoder's -cl: speed = 10 - level.
-Measurement measureDraco(const std::vector<float>& positions, int bits, int compressionLevel,
-                         int runs) {
-  const std::unique_ptr<draco::PointCloud> cloud = dracoCloud(positions);
-  draco::Encoder encoder;
-  encoder.SetAttributeQuantization(draco::GeometryAttribute::POSITION, bits);
-  encoder.SetSpeedOptions(10 - compressionLevel, 10 - compressionLevel);
-  draco::EncoderBuffer buffer;
-  Measurement m;
-  m.encodeSeconds = medianSeconds(runs, [&] {
-    buffer.Clear();
-    const draco::Status status = encoder.EncodePointCloudToBuffer(*cloud, &buffer);
-    if (!status.ok()) fail("draco encode: " + status.error_msg_string());
-  });
-  m.bytes = buffer.size();
+Measurement measureDraco(const std::vector<float>& positions, int bits, int level, int runs) {
   size_t decodedPoints = 0;
-  m.decodeSeconds = medianSeconds(runs, [&] {
-    draco::DecoderBuffer input;
-    input.Init(buffer.data(), buffer.size());
-    draco::Decoder decoder;
-    auto decoded = decoder.DecodePointCloudFromBuffer(&input);
-    if (!decoded.ok()) fail("draco decode: " + decoded.status().error_msg_string());
-    decodedPoints = decoded.value()->num_points();
-  });
+  const Measurement m = bench::measureDraco(*dracoCloud(positions), bits, level, runs, decodedPoints);
   if (decodedPoints != positions.size() / 3) fail("draco decoded a different point count");
   return m;
 }

@@ -2,7 +2,7 @@
 // and hands back snapshots as transferable arrays, one at a time, when the
 // page asks for the next one (so a fast network never floods the page).
 //
-// Messages in:  {type: 'start', wasmSource?, tetrahedra?}, {type: 'bytes', bytes},
+// Messages in:  {type: 'start', wasmSource?, tetrahedra?, geomorph?}, {type: 'bytes', bytes},
 //               {type: 'end'}, {type: 'next'} (the page is ready for a snapshot)
 // Messages out: {type: 'header', header}, {type: 'snapshot', model} (the
 //               last one has model.complete), {type: 'error', code, message}
@@ -14,6 +14,7 @@ let wanted = true;        // the page is ready for a snapshot
 let changed = false;      // chunks were applied since the last snapshot
 let headerSent = false;
 let wireframe = false;    // also send the edges of the tetrahedra
+let geomorph = false;     // also send every vertex's parent
 
 // Faces of the tetrahedra that belong to exactly one: the visible surface of
 // a tetrahedral mesh, oriented outwards when the tetrahedra are positive.
@@ -83,10 +84,9 @@ function sendSnapshot() {
   const model = decoder.snapshot();
   model.boundary = model.tetrahedra.length ? boundaryOfTetrahedra(model.tetrahedra) : new Uint32Array(0);
   model.tetrahedronEdges = model.tetrahedra.length && wireframe ? edgesOfTetrahedra(model.tetrahedra) : new Uint32Array(0);
-  const began = performance.now();
-  model.normals = vertexNormals(model.positions, [model.triangles, model.boundary]);
-  model.normalsMs = performance.now() - began;
-  model.parents = decoder.parents();
+  const surface = model.triangles.length + model.boundary.length > 0;
+  model.normals = surface ? vertexNormals(model.positions, [model.triangles, model.boundary]) : new Float32Array(0);
+  model.parents = geomorph ? decoder.parents() : new Uint32Array(0);
   model.progress = decoder.progress;
   wanted = false;
   changed = false;
@@ -106,6 +106,7 @@ function fail(error) {
 // page's 'next' requests are seen between pieces: the page gets refinements
 // while a fast download is still being decoded.
 const pending = [];
+const kSliceBytes = 16384;
 let ending = false;
 let pumping = false;
 
@@ -147,6 +148,7 @@ onmessage = ({ data }) => {
         try {
           if (data.wasmSource) setWasmSource(data.wasmSource);
           wireframe = data.tetrahedra === 'wireframe';
+          geomorph = Boolean(data.geomorph);
           decoder = await createDecoder(data.options ?? {});
           schedule();
         } catch (error) {
@@ -155,7 +157,9 @@ onmessage = ({ data }) => {
       })();
       break;
     case 'bytes':
-      pending.push(data.bytes);
+      // Slices of at most 16 KiB: a large network read still yields
+      // refinements (and the levels before a corrupt chunk) along the way.
+      for (let at = 0; at < data.bytes.length; at += kSliceBytes) pending.push(data.bytes.subarray(at, at + kSliceBytes));
       if (decoder) schedule();
       break;
     case 'end':

@@ -11,27 +11,35 @@
 // THREE.Group holds a Mesh (triangles, and the boundary of tetrahedra), a
 // LineSegments (edges) and a Points (isolated vertices).
 import {
-  BufferAttribute, BufferGeometry, DoubleSide, Group, LineBasicMaterial, LineSegments, Loader, Mesh,
-  MeshStandardMaterial, Points, PointsMaterial,
+  Box3, BufferAttribute, BufferGeometry, DoubleSide, Group, LineBasicMaterial, LineSegments, Loader, Mesh,
+  MeshStandardMaterial, Points, PointsMaterial, Sphere,
 } from 'three';
 
 const nextFrame = () =>
   new Promise((resolve) => (typeof requestAnimationFrame === 'function' ? requestAnimationFrame(() => resolve()) : setTimeout(resolve, 16)));
 
-// Replaces a geometry's attribute only when it no longer fits, so refinement
-// reuses buffers sized for the final model (from the header) instead of
-// allocating at every step; the draw range shows the current part.
-function updateAttribute(geometry, name, array, itemSize, capacity) {
+// Writes `parts` (typed arrays of one type) one after the other into a
+// geometry's attribute, replacing the attribute only when they no longer fit:
+// refinement reuses buffers sized for the final model (from the header)
+// instead of allocating at every step, and lists that are drawn together
+// (triangles and the boundary of tetrahedra) are copied once, straight into
+// place. Returns the attribute; the caller sets the draw range.
+function updateAttribute(geometry, name, parts, itemSize, capacity) {
+  const length = parts.reduce((sum, part) => sum + part.length, 0);
   let attribute = name === 'index' ? geometry.index : geometry.getAttribute(name);
-  if (!attribute || attribute.array.length < array.length) {
-    const storage = new array.constructor(Math.max(array.length, capacity * itemSize));
+  if (!attribute || attribute.array.length < length) {
+    const storage = new parts[0].constructor(Math.max(length, capacity * itemSize));
     attribute = new BufferAttribute(storage, itemSize);
     if (name === 'index') geometry.setIndex(attribute);
     else geometry.setAttribute(name, attribute);
   }
-  attribute.array.set(array);
+  let offset = 0;
+  for (const part of parts) {
+    attribute.array.set(part, offset);
+    offset += part.length;
+  }
   attribute.clearUpdateRanges?.();
-  attribute.addUpdateRange?.(0, array.length);
+  attribute.addUpdateRange?.(0, length);
   attribute.needsUpdate = true;
   return attribute;
 }
@@ -165,68 +173,64 @@ export class KDMeshLoader extends Loader {
         }
       }
       if (options.geomorph) previous = { positions: model.positions, count: model.vertexCount };
-      const position = updateAttribute(surface.geometry, 'position', start ?? model.positions, 3, capacity);
+      const position = updateAttribute(surface.geometry, 'position', [start ?? model.positions], 3, capacity);
       lines.geometry.setAttribute('position', position);
       points.geometry.setAttribute('position', position);
       if (start) morph(position, start, model.positions, model.vertexCount);
       else morphId += 1;  // a level drawn at once ends any morph in flight
-      const faces = model.tetrahedra.length
-        ? (() => {
-            const merged = new Uint32Array(model.triangles.length + model.boundary.length);
-            merged.set(model.triangles);
-            merged.set(model.boundary, model.triangles.length);
-            return merged;
-          })()
-        : model.triangles;
-      updateAttribute(surface.geometry, 'index', faces, 1, faces.length);
-      surface.geometry.setDrawRange(0, faces.length);
       // Normals come from the worker. On the final dragon (871k triangles,
       // Node 20) the worker's loop takes 90 ms and three.js's
       // computeVertexNormals 140 ms, which would block the main thread.
-      updateAttribute(surface.geometry, 'normal', model.normals, 3, capacity);
-      const edges = model.tetrahedronEdges.length
-        ? (() => {
-            const merged = new Uint32Array(model.edges.length + model.tetrahedronEdges.length);
-            merged.set(model.edges);
-            merged.set(model.tetrahedronEdges, model.edges.length);
-            return merged;
-          })()
-        : model.edges;
-      updateAttribute(lines.geometry, 'index', edges, 1, edges.length);
-      lines.geometry.setDrawRange(0, edges.length);
-      updateAttribute(points.geometry, 'index', model.points, 1, model.points.length);
-      points.geometry.setDrawRange(0, model.points.length);
-      for (const object of [surface, lines, points]) {
-        object.geometry.computeBoundingSphere();
-        object.geometry.computeBoundingBox();
-        object.visible = object.geometry.drawRange.count > 0;
+      if (model.normals.length) updateAttribute(surface.geometry, 'normal', [model.normals], 3, capacity);
+      const lists = [
+        [surface, [model.triangles, model.boundary]],
+        [lines, [model.edges, model.tetrahedronEdges]],
+        [points, [model.points]],
+      ];
+      // One bounding volume from the current vertices serves all three
+      // objects (the shared attribute is padded to the final size).
+      const box = new Box3().setFromArray(model.positions);
+      const sphere = box.getBoundingSphere(new Sphere());
+      for (const [object, parts] of lists) {
+        const count = parts.reduce((sum, part) => sum + part.length, 0);
+        if (count) updateAttribute(object.geometry, 'index', parts, 1, count);
+        object.geometry.setDrawRange(0, count);
+        object.geometry.boundingBox = box.clone();
+        object.geometry.boundingSphere = sphere.clone();
+        object.visible = count > 0;
       }
     };
 
-    worker.onmessage = async ({ data }) => {
+    // A snapshot waits for the next frame; an error that arrives meanwhile
+    // is reported after it is drawn, so the last good level stays on screen.
+    let drawing = Promise.resolve();
+    const draw = async (model) => {
+      await nextFrame();  // at most one geometry update per frame
+      if (finished) return;
+      apply(model);
+      stats.refinements += 1;
+      stats.complete = model.complete;
+      stats.model = model;
+      options.onRefine?.(group, stats);
+      if (stats.complete) finish();
+      else worker.postMessage({ type: 'next' });
+    };
+    worker.onmessage = ({ data }) => {
       if (finished) return;
       if (data.type === 'header') {
         stats.header = data.header;
         stats.bytesExpected = data.header.totalBytes;
         options.onHeader?.(data.header);
       } else if (data.type === 'snapshot') {
-        await nextFrame();  // at most one geometry update per frame
-        if (finished) return;
-        apply(data.model);
-        stats.refinements += 1;
-        stats.complete = data.model.complete;
-        stats.model = data.model;
-        options.onRefine?.(group, stats);
-        if (stats.complete) finish();
-        else worker.postMessage({ type: 'next' });
+        drawing = draw(data.model);
       } else if (data.type === 'error') {
         const error = new Error(data.message);
         error.code = data.code;
-        finish(error);
+        drawing.then(() => finish(error));
       }
     };
     worker.onerror = (event) => finish(new Error(event.message || 'the kdmesh worker failed'));
-    worker.postMessage({ type: 'start', wasmSource: this.wasmSource, tetrahedra: options.tetrahedra });
+    worker.postMessage({ type: 'start', wasmSource: this.wasmSource, tetrahedra: options.tetrahedra, geomorph: options.geomorph });
 
     group.userData = {
       stats,

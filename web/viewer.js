@@ -4,6 +4,7 @@
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { KDMeshLoader } from 'kdmesh/three';
+import { modelChecksum } from './model-checksum.js';
 
 const $ = (id) => document.getElementById(id);
 const viewer = (window.kdmeshViewer = {
@@ -86,17 +87,6 @@ let current = null;
 let controller = null;
 let framed = false;
 
-// FNV-1a over the bits of the decoded arrays: lets tests compare the page's
-// final model with a Node decode of the same file.
-function checksum(model) {
-  let h = 0x811c9dc5;
-  for (const array of [model.positions, model.points, model.edges, model.triangles, model.tetrahedra]) {
-    const words = new Uint32Array(array.buffer, array.byteOffset, array.length);
-    for (let i = 0; i < words.length; ++i) h = Math.imul(h ^ words[i], 0x01000193) >>> 0;
-  }
-  return h.toString(16);
-}
-
 function frame(group) {
   const box = new THREE.Box3().setFromObject(group);
   if (box.isEmpty()) return;
@@ -156,7 +146,7 @@ function start(load) {
       if (viewer.firstRenderMs === null) viewer.firstRenderMs = performance.now() - began;
       if (!framed) { frame(group); framed = true; }
       if (m.complete) {
-        viewer.checksum = checksum(m);
+        viewer.checksum = modelChecksum(m);
         viewer.completeMs = performance.now() - began;
         viewer.state = 'complete';
         $('progress').value = 1;

@@ -94,9 +94,9 @@ void decimate(SimplexStore& store, const std::vector<VertexSplitIds>& splits,
   std::vector<StarEntry> star;
   std::array<size_t, 5> begin{};
   records.bytes.clear();
-  // Merges are recorded last split first; `end` of each split is turned into
-  // the forward `begin` at the end.
-  std::vector<uint64_t> recordEnd(splits.size());
+  // Merges are recorded last split first, into `reversed`; each split's
+  // length turns into its forward `begin` at the end.
+  std::vector<uint64_t> recordLength(splits.size());
   std::vector<uint8_t> reversed;
 
   for (size_t k = splits.size(); k-- > 0;) {
@@ -161,7 +161,7 @@ void decimate(SimplexStore& store, const std::vector<VertexSplitIds>& splits,
       reversed.push_back(uint8_t(code | (bits & 0x3c)));
       bits = 0;
     }
-    recordEnd[k] = reversed.size() - first;  // length for now
+    recordLength[k] = reversed.size() - first;
   }
 
   // Lay the records out in split order.
@@ -170,12 +170,12 @@ void decimate(SimplexStore& store, const std::vector<VertexSplitIds>& splits,
   uint64_t at = 0;
   for (size_t k = 0; k < splits.size(); ++k) {
     records.begin[k] = at;
-    at += recordEnd[k];
+    at += recordLength[k];
   }
   records.begin[splits.size()] = at;
   // `reversed` holds split k's records at offset (total - begin[k+1]).
   for (size_t k = 0; k < splits.size(); ++k) {
-    const uint64_t length = recordEnd[k];
+    const uint64_t length = recordLength[k];
     const uint64_t from = at - records.begin[k + 1];
     std::copy(reversed.begin() + std::ptrdiff_t(from), reversed.begin() + std::ptrdiff_t(from + length),
               records.bytes.begin() + std::ptrdiff_t(records.begin[k]));

@@ -79,6 +79,26 @@ uint8_t VertexSplitter::possibleCodes(const Entry& entry) const {
   return possible;
 }
 
+// After a split, the simplices around v and v2 are exactly the star's
+// simplices and their copies and additions: the neighbours that orient the
+// new ones are found there without walking the vertex lists.
+const std::vector<uint32_t>& VertexSplitter::around(int dimension) {
+  std::vector<uint32_t>& list = around_[size_t(dimension)];
+  if (aroundReady_[size_t(dimension)]) return list;
+  aroundReady_[size_t(dimension)] = true;
+  list.clear();
+  for (size_t i = begin_[size_t(dimension) - 1]; i < begin_[size_t(dimension) + 1]; ++i) {
+    const StarEntry& entry = star_[i];
+    if (entry.dimension == dimension) {
+      list.push_back(entry.simplex);
+      if (entry.copy != kNoSimplex) list.push_back(entry.copy);
+    } else if (entry.added != kNoSimplex) {
+      list.push_back(entry.added);
+    }
+  }
+  return list;
+}
+
 int VertexSplitter::predictFlip(int dimension, uint32_t simplex, int& voteClass) {
   const int arity = dimension + 1;
   const uint32_t* mine = store_.vertices(dimension, simplex);
@@ -109,7 +129,7 @@ int VertexSplitter::predictFlip(int dimension, uint32_t simplex, int& voteClass)
     else
       ++keep;
   };
-  for (const uint32_t other : around_[size_t(dimension)]) consider(other);
+  for (const uint32_t other : around(dimension)) consider(other);
   voteClass = keep + flip == 0 ? 0 : (keep == 0 || flip == 0) ? 1 : 2;
   return flip > keep;
 }

@@ -90,7 +90,12 @@ class VertexSplitter {
   SimplexStore& store_;
   std::vector<Entry> star_;
   std::array<size_t, 5> begin_{};  // star_ entries of dimension d: [begin_[d], begin_[d+1])
-  std::array<std::vector<uint32_t>, 4> around_;  // simplices of dimension d at v or v2
+  // Simplices of dimension d at v or v2 after the split, gathered on the
+  // first orientation decision of that dimension (most splits of a surface
+  // need none of dimension 3).
+  std::array<std::vector<uint32_t>, 4> around_;
+  std::array<bool, 4> aroundReady_{};
+  const std::vector<uint32_t>& around(int dimension);
   // Code models: [dimension][possible set][step of the sequential binarisation].
   BitModel codeModels_[4][16][3];
   // Orientation models: [dimension - 2][copy or new][vote class][face of higher].
@@ -168,21 +173,7 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, Oracle&& oracl
     }
   }
 
-  // After the split, the simplices around v and v2 are exactly the star's
-  // simplices and their copies and additions: the neighbours that orient
-  // the new ones are found there without walking the vertex lists.
-  for (int d = 2; d <= SimplexStore::kMaxDimension; ++d) {
-    around_[size_t(d)].clear();
-    for (size_t i = begin_[size_t(d) - 1]; i < begin_[size_t(d) + 1]; ++i) {
-      const Entry& entry = star_[i];
-      if (entry.dimension == d) {
-        around_[size_t(d)].push_back(entry.simplex);
-        if (entry.copy != kNoSimplex) around_[size_t(d)].push_back(entry.copy);
-      } else if (entry.added != kNoSimplex) {
-        around_[size_t(d)].push_back(entry.added);
-      }
-    }
-  }
+  aroundReady_.fill(false);
   for (const Entry& entry : star_) {
     const int d = entry.dimension;
     if (entry.copy != kNoSimplex && d >= 2)

@@ -9,20 +9,12 @@ import { join } from 'node:path';
 import { chromium } from 'playwright-core';
 import { decode } from 'kdmesh';
 import { startServer } from '../../web/server.mjs';
+import { modelChecksum } from '../../web/model-checksum.js';
 import { root, cli } from '../js/fixtures.mjs';
 
 const models = mkdtempSync(join(tmpdir(), 'kdmesh-browser-'));
 const screenshots = join(root, 'build', 'screenshots');
 let server, browser, base;
-
-function checksum(model) {
-  let h = 0x811c9dc5;
-  for (const array of [model.positions, model.points, model.edges, model.triangles, model.tetrahedra]) {
-    const words = new Uint32Array(array.buffer, array.byteOffset, array.length);
-    for (let i = 0; i < words.length; ++i) h = Math.imul(h ^ words[i], 0x01000193) >>> 0;
-  }
-  return h.toString(16);
-}
 
 before(async () => {
   execFileSync(cli, ['encode', join(root, 'build', 'models', 'dragon_vrip.ply'), '-o', join(models, 'dragon.kdm'), '--bits', '12', '-q']);
@@ -73,7 +65,7 @@ test('the dragon streams through a throttled route, refines at least 5 times and
   const expected = await decode(readFileSync(join(models, 'dragon.kdm')));
   assert.equal(state.vertexCount, expected.vertexCount);
   assert.equal(state.triangleCount, expected.triangles.length / 3);
-  assert.equal(state.checksum, checksum(expected));
+  assert.equal(state.checksum, modelChecksum(expected));
   assert.deepEqual(errors, []);
   await page.close();
 });

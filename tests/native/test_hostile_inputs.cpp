@@ -5,6 +5,7 @@
 #include <string>
 
 #include "complexes.h"
+#include "io_test_support.h"
 #include "kdmesh/io.h"
 #include "kdmesh/kdmesh.h"
 #include "shapes.h"
@@ -13,35 +14,29 @@
 namespace kdmesh::test {
 namespace {
 
-Status readText(io::Format format, const std::string& text, Complex& out) {
-  io::Notes notes;
-  return io::readMemory(format, reinterpret_cast<const uint8_t*>(text.data()), text.size(), out, notes);
-}
-
 TEST(HostileInputs, ByteOrderMarksAreSkipped) {
-  Complex c;
-  ASSERT_TRUE(readText(io::Format::Obj, "\xEF\xBB\xBFv 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nf 1 2 3\r\n", c).ok());
-  EXPECT_EQ(c.simplexCount(2), 1u);
-  ASSERT_TRUE(readText(io::Format::Xyz, "\xEF\xBB\xBF" "1 2 3\n", c).ok());
-  EXPECT_EQ(c.vertexCount(), 1u);
+  const ReadResult obj = readText(io::Format::Obj, "\xEF\xBB\xBFv 0 0 0\r\nv 1 0 0\r\nv 0 1 0\r\nf 1 2 3\r\n");
+  ASSERT_TRUE(obj.status.ok());
+  EXPECT_EQ(obj.complex.simplexCount(2), 1u);
+  const ReadResult xyz = readText(io::Format::Xyz, "\xEF\xBB\xBF" "1 2 3\n");
+  ASSERT_TRUE(xyz.status.ok());
+  EXPECT_EQ(xyz.complex.vertexCount(), 1u);
 }
 
 TEST(HostileInputs, HugeObjLinesAndNegativeIndicesOutOfRange) {
-  Complex c;
   std::string line = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf";
   for (int i = 0; i < 200000; ++i) line += " 1 2 3";
   line += "\n";
-  EXPECT_TRUE(readText(io::Format::Obj, line, c).ok());  // a huge polygon, fan-split
-  const Status s = readText(io::Format::Obj, "v 0 0 0\nf -1 -2 -3\n", c);
+  EXPECT_TRUE(readText(io::Format::Obj, line).status.ok());  // a huge polygon, fan-split
+  const Status s = readText(io::Format::Obj, "v 0 0 0\nf -1 -2 -3\n").status;
   EXPECT_FALSE(s.ok());
   EXPECT_NE(s.message.find("line 2"), std::string::npos) << s.message;
 }
 
 TEST(HostileInputs, NegativeAndHugeCountsInHeaders) {
-  Complex c;
-  EXPECT_FALSE(readText(io::Format::Off, "OFF\n-3 1 0\n", c).ok());
-  EXPECT_FALSE(readText(io::Format::Off, "OFF\n2147483648 1 0\n0 0 0\n", c).ok());
-  EXPECT_FALSE(readText(io::Format::Ply, "ply\nformat ascii 1.0\nelement vertex -1\nproperty float x\nend_header\n", c).ok());
+  EXPECT_FALSE(readText(io::Format::Off, "OFF\n-3 1 0\n").status.ok());
+  EXPECT_FALSE(readText(io::Format::Off, "OFF\n2147483648 1 0\n0 0 0\n").status.ok());
+  EXPECT_FALSE(readText(io::Format::Ply, "ply\nformat ascii 1.0\nelement vertex -1\nproperty float x\nend_header\n").status.ok());
 }
 
 TEST(HostileInputs, ASingleTriangleRoundTrips) {

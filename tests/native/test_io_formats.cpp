@@ -16,6 +16,7 @@
 #include <string>
 #include <vector>
 
+#include "io_test_support.h"
 #include "kdmesh/io.h"
 
 namespace kdmesh::test {
@@ -24,101 +25,12 @@ namespace {
 namespace fs = std::filesystem;
 using io::Format;
 
-uint32_t bitsOf(float value) {
-  uint32_t bits;
-  std::memcpy(&bits, &value, sizeof bits);
-  return bits;
-}
-
-float floatOf(uint32_t bits) {
-  float value;
-  std::memcpy(&value, &bits, sizeof value);
-  return value;
-}
-
-std::vector<uint32_t> bitsOf(const std::vector<float>& values) {
-  std::vector<uint32_t> bits(values.size());
-  for (size_t i = 0; i < values.size(); ++i) bits[i] = bitsOf(values[i]);
-  return bits;
-}
-
-std::vector<uint8_t> bytesOf(const std::string& text) {
-  return std::vector<uint8_t>(text.begin(), text.end());
-}
-
-// "\n" -> "\r\n".
-std::string crlf(const std::string& text) {
-  std::string out;
-  for (char c : text) {
-    if (c == '\n') out += '\r';
-    out += c;
-  }
-  return out;
-}
-
-struct ReadResult {
-  Status status;
-  Complex complex;
-  io::Notes notes;
-
-  bool hasNote(const std::string& part) const {
-    for (const std::string& note : notes) {
-      if (note.find(part) != std::string::npos) return true;
-    }
-    return false;
-  }
-};
-
-std::string joined(const io::Notes& notes) {
-  std::string all;
-  for (const std::string& note : notes) all += "[" + note + "] ";
-  return all;
-}
-
-ReadResult readBytes(Format format, const std::vector<uint8_t>& bytes, bool weld = false) {
-  ReadResult result;
-  io::ReadOptions options;
-  options.weld = weld;
-  result.status = io::readMemory(format, bytes.data(), bytes.size(), result.complex,
-                                 result.notes, options);
-  return result;
-}
-
-ReadResult readText(Format format, const std::string& text, bool weld = false) {
-  return readBytes(format, bytesOf(text), weld);
-}
-
 ReadResult readPath(const fs::path& path, bool weld = false) {
   ReadResult result;
   io::ReadOptions options;
   options.weld = weld;
   result.status = io::readFile(path.string(), result.complex, result.notes, options);
   return result;
-}
-
-// A failed read: an InvalidInput status whose one-line message contains
-// every one of `parts`, and an emptied complex.
-void expectFailure(const ReadResult& result, const std::vector<const char*>& parts) {
-  ASSERT_FALSE(result.status.ok()) << "read succeeded with " << result.complex.vertexCount()
-                                   << " vertices";
-  EXPECT_EQ(result.status.code, ErrorCode::InvalidInput) << result.status.message;
-  EXPECT_EQ(result.status.message.find('\n'), std::string::npos) << result.status.message;
-  for (const char* part : parts) {
-    EXPECT_NE(result.status.message.find(part), std::string::npos)
-        << "message '" << result.status.message << "' lacks '" << part << "'";
-  }
-  EXPECT_EQ(result.complex.vertexCount(), 0u);
-  EXPECT_FALSE(result.complex.hasSimplices());
-}
-
-void expectValidIndices(const Complex& c) {
-  ASSERT_EQ(c.positions.size() % 3, 0u);
-  EXPECT_EQ(c.edges.size() % 2, 0u);
-  EXPECT_EQ(c.triangles.size() % 3, 0u);
-  EXPECT_EQ(c.tetrahedra.size() % 4, 0u);
-  for (const auto* list : {&c.points, &c.edges, &c.triangles, &c.tetrahedra}) {
-    for (uint32_t index : *list) ASSERT_LT(index, c.vertexCount());
-  }
 }
 
 // Every prefix of `full` either reads (with valid indices) or fails with a

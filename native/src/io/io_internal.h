@@ -118,6 +118,8 @@ class TextOut {
 
   TextOut& word(std::string_view text);
   TextOut& real(float value);
+  // The three coordinates at `xyz`.
+  TextOut& point(const float* xyz) { return real(xyz[0]).real(xyz[1]).real(xyz[2]); }
   TextOut& integer(uint64_t value);
   TextOut& endLine();
 

@@ -354,10 +354,7 @@ Status writeMedit(const Complex& complex, std::vector<uint8_t>& out) {
   text.integer(complex.vertexCount()).endLine();
   const std::vector<float>& positions = complex.positions;
   for (size_t i = 0; i < positions.size(); i += 3) {
-    text.real(positions[i])
-        .real(positions[i + 1])
-        .real(positions[i + 2])
-        .integer(0)
+    text.point(&positions[i]).integer(0)
         .endLine();
   }
   const struct {

@@ -142,11 +142,7 @@ Status writeObj(const Complex& complex, std::vector<uint8_t>& out) {
   text.word("# written by kdmesh").endLine();
   const std::vector<float>& positions = complex.positions;
   for (size_t i = 0; i < positions.size(); i += 3) {
-    text.word("v")
-        .real(positions[i])
-        .real(positions[i + 1])
-        .real(positions[i + 2])
-        .endLine();
+    text.word("v").point(&positions[i]).endLine();
   }
   // OBJ indices count from 1.
   for (uint32_t point : complex.points) {

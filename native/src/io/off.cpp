@@ -187,10 +187,7 @@ Status writeOff(const Complex& complex, std::vector<uint8_t>& out) {
       .endLine();
   const std::vector<float>& positions = complex.positions;
   for (size_t i = 0; i < positions.size(); i += 3) {
-    text.real(positions[i])
-        .real(positions[i + 1])
-        .real(positions[i + 2])
-        .endLine();
+    text.point(&positions[i]).endLine();
   }
   for (size_t i = 0; i < complex.triangles.size(); i += 3) {
     text.integer(3);

@@ -304,9 +304,7 @@ Status writeTetgenNode(const Complex& complex, std::vector<uint8_t>& out) {
   const std::vector<float>& positions = complex.positions;
   for (size_t v = 0; v < complex.vertexCount(); ++v) {
     text.integer(v + 1)  // numbered from 1, as TetGen writes by default
-        .real(positions[3 * v])
-        .real(positions[3 * v + 1])
-        .real(positions[3 * v + 2])
+        .point(&positions[3 * v])
         .endLine();
   }
   return Status::success();

@@ -631,10 +631,7 @@ Status writeVtk(const Complex& complex, std::vector<uint8_t>& out) {
   text.word("POINTS").integer(complex.vertexCount()).word("float").endLine();
   const std::vector<float>& positions = complex.positions;
   for (size_t i = 0; i < positions.size(); i += 3) {
-    text.real(positions[i])
-        .real(positions[i + 1])
-        .real(positions[i + 2])
-        .endLine();
+    text.point(&positions[i]).endLine();
   }
   const struct {
     const std::vector<uint32_t>& indices;

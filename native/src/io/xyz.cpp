@@ -28,10 +28,7 @@ Status writeXyz(const Complex& complex, std::vector<uint8_t>& out) {
   TextOut text(out);
   const std::vector<float>& positions = complex.positions;
   for (size_t i = 0; i < positions.size(); i += 3) {
-    text.real(positions[i])
-        .real(positions[i + 1])
-        .real(positions[i + 2])
-        .endLine();
+    text.point(&positions[i]).endLine();
   }
   return Status::success();
 }
