@@ -10,6 +10,7 @@
 #include "count_coder.h"
 #include "crc32.h"
 #include "kdmesh/kdmesh.h"
+#include "position_predictor.h"
 #include "quantizer.h"
 #include "range_coder.h"
 #include "simplex_store.h"
@@ -74,6 +75,7 @@ struct Decoder::State {
   bool connectivity = false;
   SimplexStore store;
   std::optional<VertexSplitter> splitter;
+  std::optional<PositionPredictor> predictor;
   uint32_t nextVertex = 1;
   std::vector<uint32_t> parents{0};  // the vertex each vertex was split from
   Complex finalComplex;              // simplices, once complete
@@ -114,6 +116,8 @@ struct Decoder::State {
         store.setCapacity(d, cap, uint32_t(std::min<uint64_t>(cap, plausible)));
       }
       splitter.emplace(store);
+      predictor.emplace(*schedule);
+      predictor->place(0, root.prefix, 0);
     }
     hasHeader = true;
     return Status::success();
@@ -134,6 +138,7 @@ struct Decoder::State {
         --left;
       } else {
         const size_t count = std::min<size_t>(left, singleLevelEnd - singleCursor);
+        if (connectivity && singleCursor == 0 && count > 0) predictor->beginSingles(store);
         refineSingles(singleCursor, singleCursor + count);
         singleCursor += count;
         left -= uint32_t(count);
@@ -195,6 +200,7 @@ struct Decoder::State {
         child.singlesBefore = cell.singlesBefore + uint32_t(newSingles.size());
         children.push_back(child);
       }
+      if (connectivity && geometric && half > 0) predictor->place(child.vertex, child.prefix, level + 1);
       if (geometric) child.prefix[axis] |= 1;
       child.vertex = added;
     }
@@ -204,8 +210,14 @@ struct Decoder::State {
   void refineSingles(size_t begin, size_t end) {
     const int axis = schedule->axis[size_t(level)];
     for (size_t i = begin; i < end; ++i) {
+      if (connectivity)
+        for (const size_t ahead : {24, 16, 8})
+          if (i + ahead < singleLevelEnd) predictor->prefetch(singles[i + ahead].vertex, int(ahead));
       Cell& cell = singles[i];
-      const bool upperHalf = !counts->codeSingle(coder, level, cell.parentOneSided, false);
+      const bool upperHalf =
+          connectivity ? !predictor->codeSingle(coder, *counts, cell.vertex, level,
+                                                cell.parentOneSided, false)
+                       : !counts->codeSingle(coder, level, cell.parentOneSided, false);
       cell.prefix[axis] = cell.prefix[axis] << 1 | upperHalf;
       cell.parentOneSided = 1;
     }

@@ -10,13 +10,16 @@
 #include "decimation.h"
 #include "kd_order.h"
 #include "kdmesh/kdmesh.h"
+#include "position_predictor.h"
 #include "quantizer.h"
 #include "range_coder.h"
 #include "simplex_store.h"
 #include "split_schedule.h"
 #include "vertex_split.h"
 
+#include <cstdio>
 namespace kdmesh {
+double multiBits[200], singleBits[200]; long singleN[200];
 namespace {
 
 constexpr size_t kFirstChunkBytes = 1024;
@@ -107,15 +110,18 @@ class ChunkWriter {
 //
 // The visitor sees cell(level, geometric, population, firstHalf,
 // parentOneSided, keptId, addedId) for cells of several vertices (addedId is
-// kNoSimplex for a one-sided split), single(level, parentOneSided,
-// inFirstHalf) for one-vertex cells, named(keyIndex, id) when a vertex gets
-// its final id, and splitDone() after each split.
+// kNoSimplex for a one-sided split), placed(id, prefix, level) for each
+// non-empty half of a geometric split, singlesBegin() before the one-vertex
+// cells of a level, single(level, parentOneSided,
+// inFirstHalf, id) for one-vertex cells, named(keyIndex, id) when a vertex
+// gets its final id, and splitDone() after each split.
 template <class Visitor>
 void traverseKdTree(const std::vector<KdKey>& keys, const SplitSchedule& schedule,
                     bool coincidentLevels, Visitor&& visitor) {
   struct Cell {
     uint32_t begin, end, id;
     bool parentOneSided;
+    uint32_t prefix[3];
   };
   struct Single {
     uint32_t key, id;
@@ -129,8 +135,10 @@ void traverseKdTree(const std::vector<KdKey>& keys, const SplitSchedule& schedul
     singles.push_back({0, 0, false});
     visitor.named(0, 0);
   } else {
-    cells.push_back({0, n, 0, false});
+    cells.push_back({0, n, 0, false, {0, 0, 0}});
   }
+  const uint32_t root[3] = {0, 0, 0};
+  visitor.placed(0, root, 0);
   for (int level = 0;; ++level) {
     const bool geometric = level < schedule.levels;
     if (!geometric && (!coincidentLevels || cells.empty())) break;
@@ -149,8 +157,16 @@ void traverseKdTree(const std::vector<KdKey>& keys, const SplitSchedule& schedul
       const bool oneSided = firstHalf == 0 || firstHalf == population;
       const uint32_t addedId = oneSided ? kNoSimplex : nextId++;
       visitor.cell(level, geometric, population, firstHalf, cell.parentOneSided, cell.id, addedId);
-      const Cell halves[2] = {{cell.begin, split, cell.id, oneSided},
-                              {split, cell.end, oneSided ? cell.id : addedId, oneSided}};
+      Cell halves[2] = {{cell.begin, split, cell.id, oneSided, {cell.prefix[0], cell.prefix[1], cell.prefix[2]}},
+                        {split, cell.end, oneSided ? cell.id : addedId, oneSided,
+                         {cell.prefix[0], cell.prefix[1], cell.prefix[2]}}};
+      if (geometric) {
+        const int axis = schedule.axis[size_t(level)];
+        halves[0].prefix[axis] = cell.prefix[axis] << 1;
+        halves[1].prefix[axis] = cell.prefix[axis] << 1 | 1;
+        for (const Cell& half : halves)
+          if (half.end > half.begin) visitor.placed(half.id, half.prefix, level + 1);
+      }
       for (const Cell& half : halves) {
         if (half.end - half.begin == 1) {
           singles.push_back({half.begin, half.id, oneSided});
@@ -161,9 +177,10 @@ void traverseKdTree(const std::vector<KdKey>& keys, const SplitSchedule& schedul
       }
       visitor.splitDone();
     }
+    if (singleLevelEnd > 0) visitor.singlesBegin();
     for (size_t i = 0; i < singleLevelEnd; ++i) {
       Single& single = singles[i];
-      visitor.single(level, single.parentOneSided, ((keys[single.key] >> bit) & 1) == 0);
+      visitor.single(level, single.parentOneSided, ((keys[single.key] >> bit) & 1) == 0, single.id);
       single.parentOneSided = true;
       visitor.splitDone();
     }
@@ -216,7 +233,9 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options) {
       void cell(int, bool, uint32_t, uint32_t, bool, uint32_t kept, uint32_t added) {
         if (added != kNoSimplex) splits.push_back({kept, added});
       }
-      void single(int, bool, bool) {}
+      void placed(uint32_t, const uint32_t*, int) {}
+      void singlesBegin() {}
+      void single(int, bool, bool, uint32_t) {}
       void named(uint32_t key, uint32_t id) { ids[vertexOfKey[key]] = id; }
       void splitDone() {}
     } naming{ids, splits, order.vertices};
@@ -242,6 +261,7 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options) {
   SimplexStore forward;
   forward.reset(header.vertexCount, false);
   VertexSplitter splitter(forward);
+  PositionPredictor predictor(schedule);
   size_t splitIndex = 0;
   double connectivityBits = 0;
   struct Coding {
@@ -251,6 +271,8 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options) {
     RangeEncoder& coder;
     ChunkWriter& chunks;
     VertexSplitter& splitter;
+    SimplexStore& forward;
+    PositionPredictor& predictor;
     const SplitRecords& records;
     size_t& splitIndex;
     double& connectivityBits;
@@ -264,7 +286,9 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options) {
         reportedLevel = level;
         report("code", double(level) / double(schedule.levels + 1));
       }
+      { double b0 = coder.cost();
       if (geometric) counts.code(coder, population, level, parentOneSided, firstHalf);
+      multiBits[level] += coder.cost() - b0; }
       if (connectivity && added != kNoSimplex) {
         const double before = coder.cost();
         splitter.split(coder, kept, added, RecordReader{&records.bytes[records.begin[splitIndex]]});
@@ -272,12 +296,23 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options) {
         connectivityBits += coder.cost() - before;
       }
     }
-    void single(int level, bool parentOneSided, bool inFirstHalf) {
-      counts.codeSingle(coder, level, parentOneSided, inFirstHalf);
+    void placed(uint32_t id, const uint32_t* prefix, int level) {
+      if (connectivity) predictor.place(id, prefix, level);
+    }
+    void singlesBegin() {
+      if (connectivity) predictor.beginSingles(forward);
+    }
+    void single(int level, bool parentOneSided, bool inFirstHalf, uint32_t id) {
+      double b0 = coder.cost();
+      struct G { double b0; RangeEncoder& c; int l; ~G(){ singleBits[l] += c.cost()-b0; singleN[l]++; } } g{b0, coder, level};
+      if (connectivity)
+        predictor.codeSingle(coder, counts, id, level, parentOneSided, inFirstHalf);
+      else
+        counts.codeSingle(coder, level, parentOneSided, inFirstHalf);
     }
     void named(uint32_t, uint32_t) {}
     void splitDone() { chunks.splitDone(); }
-  } coding{header, schedule, counts, coder, chunks, splitter, records, splitIndex,
+  } coding{header, schedule, counts, coder, chunks, splitter, forward, predictor, records, splitIndex,
            connectivityBits, connectivity, report};
   traverseKdTree(order.keys, schedule, connectivity, coding);
   header.chunkCount = chunks.finish();
@@ -286,6 +321,7 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options) {
   result.cost.geometryBits = coder.cost() - connectivityBits;
   result.statistics = splitter.statistics();
   report("code", 1);
+  if (getenv("KD_LEVELS")) { double m=0,sg=0; for (int l=0;l<schedule.levels;++l){ fprintf(stderr,"L%2d multi %9.0f single %9.0f n %8ld (%.3f)\n",l,multiBits[l],singleBits[l],singleN[l],singleN[l]?singleBits[l]/singleN[l]:0); m+=multiBits[l]; sg+=singleBits[l];} fprintf(stderr,"multi %.3f single %.3f bpv\n", m/header.vertexCount, sg/header.vertexCount);}
 
   result.bytes.resize(kHeaderBytes + body.size());
   writeHeader(header, result.bytes.data());

@@ -1,0 +1,114 @@
+// Geometry from connectivity: the split of a one-vertex cell, coded with
+// the knowledge of the vertex's neighbours in the current complex.
+//
+// A one-vertex cell's split decides one bit of its vertex's coordinate along
+// the split axis. Without connectivity that bit is close to a coin toss. With
+// it, the vertex's edges and triangles point at where it should be: near the
+// centroid of its neighbours (cells of the current level, taken at their
+// centres), and, on a surface, on the plane through that centroid whose
+// normal is the sum of the vertex's oriented triangle normals (the fan's
+// vector area, which does not depend on the vertex's own position).
+//
+// Both predictions are turned into features measured in the cell's own half
+// width along the split axis, bucketed, and used to choose an adaptive model:
+//   - where the plane crosses the split axis, relative to the split plane;
+//   - how much the plane tilts across the cell (the other axes' share of the
+//     normal): a plane nearly parallel to the split says a lot, one across it
+//     nothing;
+//   - where the centroid lies relative to the split plane;
+//   - the neighbours' distance against the cell size (coarse cells are
+//     larger than the gaps between neighbours and predict little).
+// The configuration is mirrored so that the prediction points to the upper
+// half, which lets the two mirror images share statistics.
+#pragma once
+
+#include <algorithm>
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "count_coder.h"
+#include "range_coder.h"
+#include "simplex_store.h"
+#include "split_schedule.h"
+
+namespace kdmesh {
+
+class PositionPredictor {
+ public:
+  explicit PositionPredictor(const SplitSchedule& schedule);
+
+  // The vertex's cell is now the one at `level` with these leading
+  // coordinate bits.
+  void place(uint32_t vertex, const uint32_t prefix[3], int level) {
+    if (vertex >= places_.size()) places_.resize(std::max<size_t>(vertex + 1, places_.size() * 2));
+    Place& state = places_[vertex];
+    state.prefix[0] = prefix[0];
+    state.prefix[1] = prefix[1];
+    state.prefix[2] = prefix[2];
+    state.level = uint32_t(level);
+  }
+
+  // Call before the one-vertex cells of a level split; `store` must not
+  // change until they all have.
+  void beginSingles(const SimplexStore& store);
+
+  // Hints that `vertex` will be coded `distance` one-vertex splits from now
+  // (24, 16 and 8 walk the three levels of indirection of its neighbours'
+  // cells). A memory prefetch only: coding does not depend on it.
+  void prefetch(uint32_t vertex, int distance) const {
+    if (distance == 24) {
+      __builtin_prefetch(&firstNeighbour_[vertex]);
+      __builtin_prefetch(&places_[vertex]);
+    } else if (distance == 16) {
+      __builtin_prefetch(&neighbours_[firstNeighbour_[vertex]]);
+    } else {
+      for (uint32_t i = firstNeighbour_[vertex]; i < firstNeighbour_[vertex + 1]; ++i)
+        __builtin_prefetch(&places_[neighbours_[i]]);
+    }
+  }
+
+  // Codes whether the vertex of a one-vertex cell at `level` lies in its
+  // first half, and moves the vertex's cell to that half. A vertex without
+  // neighbours falls back to `counts`. Returns the (decoded) bit.
+  template <class Coder>
+  bool codeSingle(Coder& coder, CountCoder& counts, uint32_t vertex, int level,
+                  bool parentOneSided, bool inFirstHalf) {
+    bool mirrored = false;
+    const int context = contextOf(vertex, level, mirrored);
+    const bool first =
+        context < 0 ? counts.codeSingle(coder, level, parentOneSided, inFirstHalf)
+                    : coder.bit(models_[size_t(context)], inFirstHalf != mirrored) != mirrored;
+    Place& p = places_[vertex];
+    const int axis = axis_[size_t(level)];
+    p.prefix[axis] = p.prefix[axis] << 1 | uint32_t(!first);
+    p.level = uint32_t(level + 1);
+    return first;
+  }
+
+  // Statistics for `kdmesh info`: one-vertex splits coded with a prediction.
+  uint64_t predictedSplits() const { return predicted_; }
+
+ private:
+  struct Place {
+    uint32_t prefix[3];
+    uint32_t level;
+  };
+
+  int contextOf(uint32_t vertex, int level, bool& mirrored);
+  void centre(const Place& place, double out[3]) const;
+
+  std::vector<uint8_t> axis_;                  // split axis per level
+  std::vector<std::array<double, 3>> width_;   // cell width per level and axis
+  std::vector<Place> places_;
+  // The current complex's edges as neighbour lists (compressed rows),
+  // rebuilt when a level's one-vertex cells start splitting: the complex
+  // does not change while they do, and contiguous lists let the lookups of
+  // a vertex's neighbours proceed in parallel, where the store's linked
+  // incidence lists would chain them.
+  std::vector<uint32_t> firstNeighbour_, neighbours_;
+  std::vector<BitModel> models_;
+  uint64_t predicted_ = 0;
+};
+
+}  // namespace kdmesh
