@@ -115,8 +115,8 @@ struct Decoder::State {
         const uint32_t cap = uint32_t(std::min<uint64_t>(caps[size_t(d)], 0xffffffffu));
         store.setCapacity(d, cap, uint32_t(std::min<uint64_t>(cap, plausible)));
       }
-      splitter.emplace(store);
       predictor.emplace(*schedule);
+      splitter.emplace(store, *predictor);
       predictor->place(0, root.prefix, 0);
     }
     hasHeader = true;
@@ -187,7 +187,7 @@ struct Decoder::State {
         store.growVertices(std::min<uint32_t>(header.vertexCount, 2 * store.vertexCapacity()));
       parents.push_back(cell.vertex);
       const double before = coder.cost();
-      if (!splitter->split(coder, cell.vertex, added, [] { return uint8_t(0); })) return false;
+      if (!splitter->split(coder, cell.vertex, added, level, [] { return uint8_t(0); })) return false;
       cost.connectivityBits += coder.cost() - before;
     }
     for (const uint32_t half : {firstHalf, population - firstHalf}) {

@@ -260,8 +260,8 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options) {
   CountCoder counts(schedule.levels);
   SimplexStore forward;
   forward.reset(header.vertexCount, false);
-  VertexSplitter splitter(forward);
   PositionPredictor predictor(schedule);
+  VertexSplitter splitter(forward, predictor);
   size_t splitIndex = 0;
   double connectivityBits = 0;
   struct Coding {
@@ -291,7 +291,7 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options) {
       multiBits[level] += coder.cost() - b0; }
       if (connectivity && added != kNoSimplex) {
         const double before = coder.cost();
-        splitter.split(coder, kept, added, RecordReader{&records.bytes[records.begin[splitIndex]]});
+        splitter.split(coder, kept, added, level, RecordReader{&records.bytes[records.begin[splitIndex]]});
         ++splitIndex;
         connectivityBits += coder.cost() - before;
       }

@@ -24,6 +24,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cmath>
 #include <cstdint>
 #include <vector>
 
@@ -84,6 +85,22 @@ class PositionPredictor {
     p.prefix[axis] = p.prefix[axis] << 1 | uint32_t(!first);
     p.level = uint32_t(level + 1);
     return first;
+  }
+
+  bool geometric(int level) const { return size_t(level) < axis_.size(); }
+
+  // For a cell split at a geometric `level`: the cosine of the angle between
+  // the split axis and the direction from v's cell centre to w's.
+  double axisCosine(uint32_t v, uint32_t w, int level) const {
+    double from[3], to[3];
+    centre(places_[v], from);
+    centre(places_[w], to);
+    double squared = 0;
+    for (int a = 0; a < 3; ++a) {
+      to[a] -= from[a];
+      squared += to[a] * to[a];
+    }
+    return squared > 0 ? to[axis_[size_t(level)]] / std::sqrt(squared) : 0;
   }
 
   // Statistics for `kdmesh info`: one-vertex splits coded with a prediction.

@@ -1,5 +1,7 @@
 #include "vertex_split.h"
 
+#include <cmath>
+
 namespace kdmesh {
 namespace {
 
@@ -77,6 +79,39 @@ uint8_t VertexSplitter::possibleCodes(const Entry& entry) const {
     possible &= kAllowedBy[face->code];
   }
   return possible;
+}
+
+// Where each edge's other vertex lies against the split: the cosine of the
+// angle between the split axis and the direction from v's cell centre to
+// it. Negative cosines point to v's half, positive ones to v2's; the two
+// edges that become triangles (code 4) of an edge expansion are usually the
+// two closest to the split plane, hence the rank of |cosine| as well.
+// Class 0: no geometry (splits of coincident vertices).
+void VertexSplitter::classifyEdges(uint32_t v, int level) {
+  const size_t first = begin_[1], last = begin_[2];
+  if (!geometry_.geometric(level)) {
+    for (size_t i = first; i < last; ++i) star_[i].geometry = 0;
+    return;
+  }
+  cosines_.resize(last - first);
+  double smallest = 2, second = 2;
+  for (size_t i = first; i < last; ++i) {
+    const double cosine = geometry_.axisCosine(v, star_[i].others[0], level);
+    cosines_[i - first] = cosine;
+    const double magnitude = std::fabs(cosine);
+    if (magnitude < smallest) {
+      second = smallest;
+      smallest = magnitude;
+    } else if (magnitude < second) {
+      second = magnitude;
+    }
+  }
+  for (size_t i = first; i < last; ++i) {
+    const double cosine = cosines_[i - first], magnitude = std::fabs(cosine);
+    const int rank = magnitude <= smallest ? 0 : magnitude <= second ? 1 : 2;
+    const int bucket = magnitude < 0.2 ? 0 : magnitude < 0.45 ? 1 : magnitude < 0.7 ? 2 : 3;
+    star_[i].geometry = uint8_t(1 + (rank * 2 + (cosine > 0)) * 4 + bucket);
+  }
 }
 
 // After a split, the simplices around v and v2 are exactly the star's

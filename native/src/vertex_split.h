@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "kdmesh/kdmesh.h"
+#include "position_predictor.h"
 #include "range_coder.h"
 #include "simplex_store.h"
 
@@ -53,6 +54,7 @@ struct StarEntry {
   uint8_t position;    // of the vertex in the simplex's tuple
   uint8_t code;
   uint8_t record;
+  uint8_t geometry;  // edges: class of the other vertex's direction (see classifyEdges)
   uint32_t copy, added;  // children made by codes 3 and 4
 };
 
@@ -63,13 +65,18 @@ void gatherStar(SimplexStore& store, uint32_t v, std::vector<StarEntry>& star,
 
 class VertexSplitter {
  public:
-  explicit VertexSplitter(SimplexStore& store) : store_(store) {}
+  // `geometry` knows where the cells are; the split of a cell at a
+  // geometric level puts v in its first half and v2 in the second, which
+  // predicts where v's edges go.
+  VertexSplitter(SimplexStore& store, const PositionPredictor& geometry)
+      : store_(store), geometry_(geometry) {}
 
-  // Splits `v` into `v` and `v2`. `next()` of the oracle gives the record
-  // byte of each star entry in canonical order. Returns false when the codes
-  // contradict each other or the store is full: corrupt data on the decoder.
+  // Splits `v`, whose cell is at `level`, into `v` and `v2`. `next()` of the
+  // oracle gives the record byte of each star entry in canonical order.
+  // Returns false when the codes contradict each other or the store is full:
+  // corrupt data on the decoder.
   template <class Coder, class Oracle>
-  bool split(Coder& coder, uint32_t v, uint32_t v2, Oracle&& oracle);
+  bool split(Coder& coder, uint32_t v, uint32_t v2, int level, Oracle&& oracle);
 
   const ConnectivityStatistics& statistics() const { return statistics_; }
 
@@ -81,14 +88,17 @@ class VertexSplitter {
 
   uint8_t possibleCodes(const Entry& entry) const;
   const Entry* findFace(int dimension, const uint32_t* others) const;
+  void classifyEdges(uint32_t v, int level);
   template <class Coder>
-  uint8_t codeSymbol(Coder& coder, int dimension, uint8_t possible, uint8_t code);
+  uint8_t codeSymbol(Coder& coder, BitModel (&models)[16][3], uint8_t possible, uint8_t code);
   template <class Coder>
   void decideOrientation(Coder& coder, int dimension, uint32_t simplex, bool isCopy, uint8_t target);
   int predictFlip(int dimension, uint32_t simplex, int& voteClass);
 
   SimplexStore& store_;
+  const PositionPredictor& geometry_;
   std::vector<Entry> star_;
+  std::vector<double> cosines_;
   std::array<size_t, 5> begin_{};  // star_ entries of dimension d: [begin_[d], begin_[d+1])
   // Simplices of dimension d at v or v2 after the split, gathered on the
   // first orientation decision of that dimension (most splits of a surface
@@ -96,20 +106,23 @@ class VertexSplitter {
   std::array<std::vector<uint32_t>, 4> around_;
   std::array<bool, 4> aroundReady_{};
   const std::vector<uint32_t>& around(int dimension);
-  // Code models: [dimension][possible set][step of the sequential binarisation].
+  // Code models: [dimension][possible set][step of the sequential binarisation];
+  // edges have theirs per geometry class instead of dimension.
+  static constexpr int kEdgeClasses = 25;
   BitModel codeModels_[4][16][3];
+  BitModel edgeModels_[kEdgeClasses][16][3];
   // Orientation models: [dimension - 2][copy or new][vote class][face of higher].
   BitModel orientationModels_[2][2][3][2];
   ConnectivityStatistics statistics_;
 };
 
 template <class Coder>
-uint8_t VertexSplitter::codeSymbol(Coder& coder, int dimension, uint8_t possible, uint8_t code) {
+uint8_t VertexSplitter::codeSymbol(Coder& coder, BitModel (&models)[16][3], uint8_t possible, uint8_t code) {
   int step = 0;
   for (uint8_t c = 1; c <= 4; ++c) {
     if (!(possible & (1u << (c - 1)))) continue;
     if ((possible >> c) == 0) return c;  // the last candidate left
-    if (coder.bit(codeModels_[dimension][possible][step], c == code)) return c;
+    if (coder.bit(models[possible][step], c == code)) return c;
     ++step;
   }
   return 0;  // unreachable: `possible` is never empty here
@@ -135,15 +148,16 @@ void VertexSplitter::decideOrientation(Coder& coder, int dimension, uint32_t sim
 }
 
 template <class Coder, class Oracle>
-bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, Oracle&& oracle) {
+bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, Oracle&& oracle) {
   gatherStar(store_, v, star_, begin_);
+  classifyEdges(v, level);
   ++statistics_.vertexSplits;
   for (Entry& entry : star_) {
     entry.record = oracle();
     const uint8_t possible = possibleCodes(entry);
     if (possible == 0) return false;
-    entry.code = codeSymbol(coder, entry.dimension, possible,
-                            uint8_t((entry.record & split_record::kCodeMask) + 1));
+    entry.code = codeSymbol(coder, entry.dimension == 1 ? edgeModels_[entry.geometry] : codeModels_[entry.dimension],
+                            possible, uint8_t((entry.record & split_record::kCodeMask) + 1));
     ++statistics_.codes[entry.dimension][entry.code - 1];
   }
 
