@@ -114,6 +114,31 @@ void VertexSplitter::classifyEdges(uint32_t v, int level) {
   }
 }
 
+// Edges of the star that share a triangle are fan neighbours: around a
+// manifold vertex the codes run 1...1 4 2...2 4 along the fan, so the codes
+// already given to an edge's fan neighbours say much about its own. Two
+// neighbours per edge are kept (a manifold fan has no more).
+void VertexSplitter::linkFans() {
+  for (size_t i = begin_[1]; i < begin_[2]; ++i) {
+    star_[i].fanCodes = 0;
+    star_[i].fan[0] = star_[i].fan[1] = kNoSimplex;
+  }
+  auto link = [this](const Entry* from, size_t to) {
+    uint32_t* fan = const_cast<Entry*>(from)->fan;
+    if (fan[0] == kNoSimplex)
+      fan[0] = uint32_t(to);
+    else if (fan[1] == kNoSimplex)
+      fan[1] = uint32_t(to);
+  };
+  for (size_t i = begin_[2]; i < begin_[3]; ++i) {
+    const Entry* first = findFace(1, &star_[i].others[0]);
+    const Entry* second = findFace(1, &star_[i].others[1]);
+    if (first == nullptr || second == nullptr) continue;
+    link(first, size_t(second - star_.data()));
+    link(second, size_t(first - star_.data()));
+  }
+}
+
 // After a split, the simplices around v and v2 are exactly the star's
 // simplices and their copies and additions: the neighbours that orient the
 // new ones are found there without walking the vertex lists.

@@ -55,6 +55,8 @@ struct StarEntry {
   uint8_t code;
   uint8_t record;
   uint8_t geometry;  // edges: class of the other vertex's direction (see classifyEdges)
+  uint8_t fanCodes;  // edges: codes already given to fan neighbours, bits 0 (1), 1 (2), 2 (3 or 4)
+  uint32_t fan[2];   // edges: star indices of two edges sharing a triangle with this one
   uint32_t copy, added;  // children made by codes 3 and 4
 };
 
@@ -89,6 +91,7 @@ class VertexSplitter {
   uint8_t possibleCodes(const Entry& entry) const;
   const Entry* findFace(int dimension, const uint32_t* others) const;
   void classifyEdges(uint32_t v, int level);
+  void linkFans();
   template <class Coder>
   uint8_t codeSymbol(Coder& coder, BitModel (&models)[16][3], uint8_t possible, uint8_t code);
   template <class Coder>
@@ -110,7 +113,7 @@ class VertexSplitter {
   // edges have theirs per geometry class instead of dimension.
   static constexpr int kEdgeClasses = 25;
   BitModel codeModels_[4][16][3];
-  BitModel edgeModels_[kEdgeClasses][16][3];
+  BitModel edgeModels_[3][8][kEdgeClasses][16][3];  // [cut edges so far][fan codes][class]
   // Orientation models: [dimension - 2][copy or new][vote class][face of higher].
   BitModel orientationModels_[2][2][3][2];
   ConnectivityStatistics statistics_;
@@ -152,12 +155,23 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, Ora
   gatherStar(store_, v, star_, begin_);
   classifyEdges(v, level);
   ++statistics_.vertexSplits;
+  linkFans();
+  int cutEdges = 0;  // edges coded 4 so far: an edge expansion has two
   for (Entry& entry : star_) {
     entry.record = oracle();
     const uint8_t possible = possibleCodes(entry);
     if (possible == 0) return false;
-    entry.code = codeSymbol(coder, entry.dimension == 1 ? edgeModels_[entry.geometry] : codeModels_[entry.dimension],
-                            possible, uint8_t((entry.record & split_record::kCodeMask) + 1));
+    entry.code = codeSymbol(
+        coder,
+        entry.dimension == 1 ? edgeModels_[std::min(cutEdges, 2)][entry.fanCodes][entry.geometry]
+                             : codeModels_[entry.dimension],
+        possible, uint8_t((entry.record & split_record::kCodeMask) + 1));
+    if (entry.dimension == 1) {
+      cutEdges += entry.code == 4;
+      const uint8_t bit = uint8_t(1u << std::min(entry.code - 1, 2));
+      for (const uint32_t neighbour : entry.fan)
+        if (neighbour != kNoSimplex) star_[neighbour].fanCodes |= bit;
+    }
     ++statistics_.codes[entry.dimension][entry.code - 1];
   }
 
