@@ -6,7 +6,10 @@
 //   - the population p (exact up to 15, then by its power of two),
 //   - the kd-tree level (cell size relative to the sampling density),
 //   - whether the parent split sent all its vertices to one side, and
-//   - the node of the bisection tree (the decisions taken so far).
+//   - the node of the bisection tree (the decisions taken so far),
+//   - and, for populations up to 15 in a complex, a geometry class from the
+//     cell's neighbourhood (PositionPredictor::countContext), in place of
+//     the parent's split.
 // After six decisions the few remaining candidates of a large cell are nearly
 // equiprobable and are coded uniformly.
 #pragma once
@@ -20,8 +23,11 @@ namespace kdmesh {
 
 class CountCoder {
  public:
-  explicit CountCoder(int levels) : levels_(levels < 1 ? 1 : levels) {
+  // `geometryClasses`: how many classes code() may be given (0 for none).
+  CountCoder(int levels, int geometryClasses) : levels_(levels < 1 ? 1 : levels) {
     models_.resize(size_t(levels_) * kParentClasses * kContextsPerLevel);
+    geometryModels_.resize(size_t(levels_) * size_t(geometryClasses) * kSmallNodes);
+    geometryClasses_ = geometryClasses;
   }
 
   // The count of a one-vertex cell, 1 when the vertex is in the first half;
@@ -33,14 +39,18 @@ class CountCoder {
                      inFirstHalf);
   }
 
-  // `parentOneSided`: the parent cell's split left one half empty.
+  // `parentOneSided`: the parent cell's split left one half empty;
+  // `geometryClass` 1.. a class from the neighbourhood, 0 without one.
   // On the encoder returns `firstHalf`; on the decoder returns the decoded count.
   template <class Coder>
   uint32_t code(Coder& coder, uint32_t population, int level, bool parentOneSided,
-                uint32_t firstHalf) {
-    BitModel* models = &models_[(size_t(level) * kParentClasses + parentOneSided) *
-                                    kContextsPerLevel +
-                                populationOffset(population)];
+                uint32_t firstHalf, int geometryClass = 0) {
+    BitModel* models =
+        geometryClass > 0 && population <= kExactPopulations
+            ? &geometryModels_[(size_t(level) * size_t(geometryClasses_) + size_t(geometryClass)) * kSmallNodes +
+                               populationOffset(population)]
+            : &models_[(size_t(level) * kParentClasses + parentOneSided) * kContextsPerLevel +
+                       populationOffset(population)];
     uint32_t low = 0, candidates = population + 1, node = 1;
     while (candidates > 1) {
       if (node >= kTreeNodes)
@@ -81,7 +91,8 @@ class CountCoder {
   }
 
   int levels_;
-  std::vector<BitModel> models_;
+  int geometryClasses_ = 0;
+  std::vector<BitModel> models_, geometryModels_;
 };
 
 }  // namespace kdmesh

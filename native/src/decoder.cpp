@@ -95,12 +95,12 @@ struct Decoder::State {
   Status startBody(size_t available) {
     schedule.emplace(header);
     dequantizer.emplace(header);
-    counts.emplace(schedule->levels);
+    connectivity = header.maxDimension > 0;
+    counts.emplace(schedule->levels, connectivity ? PositionPredictor::kCountClasses : 0);
     coder.setMeasuring(options.measureCost);
     const Cell root{{0, 0, 0}, header.vertexCount, 0, 0, 0};
     (header.vertexCount == 1 ? singles : cells).push_back(root);
     singleLevelEnd = singles.size();
-    connectivity = header.maxDimension > 0;
     if (connectivity) {
       // Vertex lists grow with the vertices actually decoded, not with the
       // count a (possibly hostile) header announces.
@@ -172,9 +172,13 @@ struct Decoder::State {
   bool splitCell(const Cell& cell) {
     const uint32_t population = cell.population;
     const bool geometric = level < schedule->levels;
-    const uint32_t firstHalf = geometric
-                                   ? counts->code(coder, population, level, cell.parentOneSided, 0)
-                                   : population / 2;
+    uint32_t firstHalf = population / 2;
+    if (geometric) {
+      bool mirrored = false;
+      const int geometryClass = connectivity ? predictor->countContext(store, cell.vertex, level, mirrored) : 0;
+      firstHalf = counts->code(coder, population, level, cell.parentOneSided, 0, geometryClass);
+      if (mirrored) firstHalf = population - firstHalf;
+    }
     const bool oneSided = firstHalf == 0 || firstHalf == population;
     Cell child = cell;
     child.parentOneSided = oneSided;

@@ -257,7 +257,7 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options) {
   std::vector<uint8_t> body;
   ChunkWriter chunks(body, options.chunkBytes);
   RangeEncoder& coder = chunks.coder();
-  CountCoder counts(schedule.levels);
+  CountCoder counts(schedule.levels, connectivity ? PositionPredictor::kCountClasses : 0);
   SimplexStore forward;
   forward.reset(header.vertexCount, false);
   PositionPredictor predictor(schedule);
@@ -287,7 +287,12 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options) {
         report("code", double(level) / double(schedule.levels + 1));
       }
       { double b0 = coder.cost();
-      if (geometric) counts.code(coder, population, level, parentOneSided, firstHalf);
+      if (geometric) {
+        bool mirrored = false;
+        const int geometryClass = connectivity ? predictor.countContext(forward, kept, level, mirrored) : 0;
+        counts.code(coder, population, level, parentOneSided, mirrored ? population - firstHalf : firstHalf,
+                    geometryClass);
+      }
       multiBits[level] += coder.cost() - b0; }
       if (connectivity && added != kNoSimplex) {
         const double before = coder.cost();

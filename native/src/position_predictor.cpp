@@ -11,11 +11,8 @@ constexpr int kPlaneBuckets = 6;
 constexpr int kCentroidBuckets = 10;
 
 // The root mean square neighbour distance in half widths of the cell, from
-// the squares.
-int scaleClass(double meanSquaredDistance, double halfWidth) {
-  const double r = meanSquaredDistance / (halfWidth * halfWidth);
-  return r < 4 ? 0 : r < 16 ? 1 : r < 64 ? 2 : r < 256 ? 3 : 4;
-}
+// its square.
+int scaleClass(double r) { return r < 4 ? 0 : r < 16 ? 1 : r < 64 ? 2 : r < 256 ? 3 : 4; }
 
 // The plane's rise across the cell along the other axes, against its rise
 // along the split axis.
@@ -72,62 +69,95 @@ void PositionPredictor::beginSingles(const SimplexStore& store) {
   firstNeighbour_[0] = 0;
 }
 
+void PositionPredictor::Neighbourhood::add(const double position[3]) {
+  double p[3];
+  for (int a = 0; a < 3; ++a) {
+    p[a] = position[a] - at[a];
+    sum[a] += p[a];
+    squaredDistance += p[a] * p[a];
+  }
+  // The plane's orientation does not matter, so neighbours need no order:
+  // the normal sums the cross products of the offsets of consecutive
+  // neighbours, each turned to agree with the sum so far.
+  if (count > 0) {
+    const double cross[3] = {previous[1] * p[2] - previous[2] * p[1], previous[2] * p[0] - previous[0] * p[2],
+                             previous[0] * p[1] - previous[1] * p[0]};
+    const double sign = cross[0] * normal[0] + cross[1] * normal[1] + cross[2] * normal[2] < 0 ? -1 : 1;
+    for (int a = 0; a < 3; ++a) normal[a] += sign * cross[a];
+  }
+  for (int a = 0; a < 3; ++a) previous[a] = p[a];
+  ++count;
+}
+
+PositionPredictor::Features PositionPredictor::features(const Neighbourhood& around, int level) const {
+  Features f;
+  const int axis = axis_[size_t(level)];
+  double halfWidth[3];
+  for (int a = 0; a < 3; ++a) halfWidth[a] = width_[size_t(level)][size_t(a)] * 0.5;
+  const double inverse = 1.0 / double(around.count);
+  double centroid[3];  // relative to the cell centre
+  for (int a = 0; a < 3; ++a) centroid[a] = around.sum[a] * inverse;
+  f.meanSquaredDistance = around.squaredDistance * inverse / (halfWidth[axis] * halfWidth[axis]);
+  f.centroidOffset = centroid[axis] / halfWidth[axis];
+  const double* normal = around.normal;
+  const double along = std::fabs(normal[axis]) * halfWidth[axis];
+  if (along > 0) {
+    double across = 0, offset = 0;
+    for (int a = 0; a < 3; ++a) {
+      offset -= normal[a] * centroid[a];
+      if (a != axis) across += std::fabs(normal[a]) * halfWidth[a];
+    }
+    f.planeOffset = -offset / (normal[axis] * halfWidth[axis]);
+    f.tilt = across / along;
+    f.hasPlane = true;
+  }
+  f.mirrored = (f.hasPlane ? f.planeOffset : f.centroidOffset) < 0;
+  if (f.mirrored) {
+    f.planeOffset = -f.planeOffset;
+    f.centroidOffset = -f.centroidOffset;
+  }
+  return f;
+}
+
 int PositionPredictor::contextOf(uint32_t vertex, int level, bool& mirrored) {
   const uint32_t* neighbour = neighbours_.data() + firstNeighbour_[vertex];
   const uint32_t count = firstNeighbour_[vertex + 1] - firstNeighbour_[vertex];
   if (count == 0) return -1;
   ++predicted_;
-  double at[3], halfWidth[3];
-  centre(places_[vertex], at);
-  for (int a = 0; a < 3; ++a) halfWidth[a] = width_[size_t(level)][size_t(a)] * 0.5;
-  // The plane's orientation does not matter, so neighbours need no order:
-  // the normal sums the cross products of the offsets of consecutive
-  // neighbours, each turned to agree with the sum so far.
-  double sum[3] = {0, 0, 0}, normal[3] = {0, 0, 0}, previous[3] = {0, 0, 0}, squaredDistance = 0;
+  Neighbourhood around;
+  centre(places_[vertex], around.at);
   for (uint32_t i = 0; i < count; ++i) {
     double p[3];
     centre(places_[neighbour[i]], p);
-    for (int a = 0; a < 3; ++a) {
-      p[a] -= at[a];
-      sum[a] += p[a];
-      squaredDistance += p[a] * p[a];
-    }
-    if (i > 0) {
-      const double cross[3] = {previous[1] * p[2] - previous[2] * p[1], previous[2] * p[0] - previous[0] * p[2],
-                               previous[0] * p[1] - previous[1] * p[0]};
-      const double sign = cross[0] * normal[0] + cross[1] * normal[1] + cross[2] * normal[2] < 0 ? -1 : 1;
-      for (int a = 0; a < 3; ++a) normal[a] += sign * cross[a];
-    }
-    for (int a = 0; a < 3; ++a) previous[a] = p[a];
+    around.add(p);
   }
-  const double inverse = 1.0 / double(count);
-  double centroid[3];
-  for (int a = 0; a < 3; ++a) centroid[a] = at[a] + sum[a] * inverse;
-  const double spread = squaredDistance * inverse;
+  const Features f = features(around, level);
+  mirrored = f.mirrored;
+  const int tilt = f.hasPlane ? tiltClass(f.tilt) : kTiltClasses - 1;
+  return ((scaleClass(f.meanSquaredDistance) * kTiltClasses + tilt) * kPlaneBuckets + planeBucket(f.planeOffset)) *
+             kCentroidBuckets +
+         centroidBucket(f.centroidOffset);
+}
 
-  const int axis = axis_[size_t(level)];
-  double centroidOffset = (centroid[axis] - at[axis]) / halfWidth[axis];
-
-  int tilt = kTiltClasses - 1;
-  double planeOffset = 0;
-  const double along = std::fabs(normal[axis]) * halfWidth[axis];
-  if (along > 0) {
-    double across = 0, f = 0;
-    for (int a = 0; a < 3; ++a) {
-      f += normal[a] * (at[a] - centroid[a]);
-      if (a != axis) across += std::fabs(normal[a]) * halfWidth[a];
-    }
-    planeOffset = -f / (normal[axis] * halfWidth[axis]);
-    tilt = tiltClass(across / along);
+int PositionPredictor::countContext(SimplexStore& store, uint32_t vertex, int level, bool& mirrored) const {
+  Neighbourhood around;
+  centre(places_[vertex], around.at);
+  store.forEachIncident(1, vertex, [&](uint32_t edge, uint32_t position) {
+    double p[3];
+    centre(places_[store.vertices(1, edge)[1 - position]], p);
+    around.add(p);
+  });
+  mirrored = false;
+  if (around.count == 0) return 0;
+  const Features f = features(around, level);
+  mirrored = f.mirrored;
+  if (!f.hasPlane) {
+    const double c = f.centroidOffset;
+    return c < 0.5 ? 6 : c < 1.5 ? 7 : 8;
   }
-  mirrored = (tilt < kTiltClasses - 1 ? planeOffset : centroidOffset) < 0;
-  if (mirrored) {
-    planeOffset = -planeOffset;
-    centroidOffset = -centroidOffset;
-  }
-  const int scale = scaleClass(spread, halfWidth[axis]);
-  return ((scale * kTiltClasses + tilt) * kPlaneBuckets + planeBucket(planeOffset)) * kCentroidBuckets +
-         centroidBucket(centroidOffset);
+  // How close the plane comes to the split plane inside the cell, in half widths.
+  const double gap = f.planeOffset - f.tilt;
+  return gap <= 0 ? 1 : gap < 0.5 ? 2 : gap < 1 ? 3 : gap < 2 ? 4 : 5;
 }
 
 }  // namespace kdmesh

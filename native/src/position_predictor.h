@@ -54,6 +54,14 @@ class PositionPredictor {
   // change until they all have.
   void beginSingles(const SimplexStore& store);
 
+  // Geometry class (0..kCountClasses-1) of the split of a cell of several
+  // vertices at `level` whose vertex in the complex is `vertex`: how close
+  // its neighbourhood's plane comes to the split plane (1..5, or 6..8 from
+  // the centroid alone without a plane, 0 without neighbours). With
+  // `mirrored` the prediction favours the first half.
+  static constexpr int kCountClasses = 9;
+  int countContext(SimplexStore& store, uint32_t vertex, int level, bool& mirrored) const;
+
   // Hints that `vertex` will be coded `distance` one-vertex splits from now
   // (24, 16 and 8 walk the three levels of indirection of its neighbours'
   // cells). A memory prefetch only: coding does not depend on it.
@@ -112,6 +120,25 @@ class PositionPredictor {
     uint32_t level;
   };
 
+  // Neighbours' cell centres, summed relative to the vertex's cell centre.
+  struct Neighbourhood {
+    double at[3];
+    double sum[3] = {0, 0, 0}, normal[3] = {0, 0, 0}, previous[3] = {0, 0, 0};
+    double squaredDistance = 0;
+    uint32_t count = 0;
+    void add(const double position[3]);
+  };
+  // The predictions against the split at `level`, in half widths of the
+  // cell along the split axis, mirrored so that the plane (or without one,
+  // the centroid) lies on the upper side.
+  struct Features {
+    double planeOffset = 0;          // where the plane meets the split axis
+    double tilt = 0;                 // the plane's rise across the cell
+    double centroidOffset = 0;
+    double meanSquaredDistance = 0;  // of the neighbours, in squared half widths
+    bool hasPlane = false, mirrored = false;
+  };
+  Features features(const Neighbourhood& around, int level) const;
   int contextOf(uint32_t vertex, int level, bool& mirrored);
   void centre(const Place& place, double out[3]) const;
 
