@@ -242,14 +242,17 @@ int runInfo(const std::string& input, bool json) {
                 jsonNumber(8.0 * double(bytes.size()) / n).c_str(),
                 jsonNumber(cost.geometryBits / n).c_str(),
                 jsonNumber(cost.connectivityBits / n).c_str());
-    std::printf("  \"operators\": {\"vertexSplits\": %" PRIu64 ", \"edgeExpansions\": 0, "
+    std::printf("  \"operators\": {\"vertexSplits\": %" PRIu64 ", \"edgeExpansions\": %" PRIu64 ", "
                 "\"codes\": [",
-                stats.vertexSplits);
+                stats.vertexSplits, stats.edgeExpansions);
     for (int d = 0; d < 4; ++d)
       std::printf("%s[%" PRIu64 ", %" PRIu64 ", %" PRIu64 ", %" PRIu64 "]", d ? ", " : "", stats.codes[d][0],
                   stats.codes[d][1], stats.codes[d][2], stats.codes[d][3]);
     std::printf("], \"orientationBits\": %" PRIu64 ", \"orientationMispredicted\": %" PRIu64 "},\n",
                 stats.orientationBits, stats.orientationMispredicted);
+    std::printf("  \"predictions\": {\"edgeCodesByDirection\": %" PRIu64 ", \"countPredictions\": %" PRIu64
+                ", \"positionPredictions\": %" PRIu64 "},\n",
+                stats.edgeCodesByDirection, stats.countPredictions, stats.positionPredictions);
     std::printf("  \"chunks\": [");
     const auto& chunks = decoder.chunks();
     for (size_t i = 0; i < chunks.size(); ++i)
@@ -276,9 +279,11 @@ int runInfo(const std::string& input, bool json) {
               (8.0 * double(bytes.size()) - cost.geometryBits - cost.connectivityBits) / n);
   if (h.maxDimension > 0) {
     // As the paper's Table 1: which operator undid each of the n - 1 merges.
-    std::printf("operators       %" PRIu64 " vertex splits (%.1f %% of %u merges), 0 edge expansions\n",
+    std::printf("operators       %" PRIu64 " vertex splits (%.1f %% of %u merges), of which %" PRIu64
+                " (%.1f %%) edge expansions\n",
                 stats.vertexSplits, n > 1 ? 100.0 * double(stats.vertexSplits) / (n - 1) : 0.0,
-                h.vertexCount - 1);
+                h.vertexCount - 1, stats.edgeExpansions,
+                stats.vertexSplits ? 100.0 * double(stats.edgeExpansions) / double(stats.vertexSplits) : 0.0);
     static const char* const kNames[4] = {"vertex", "edge", "triangle", "tetrahedron"};
     for (int d = 0; d < 4; ++d) {
       const auto& c = stats.codes[size_t(d)];
@@ -288,6 +293,9 @@ int runInfo(const std::string& input, bool json) {
     }
     std::printf("  orientation   %" PRIu64 " decisions, %" PRIu64 " mispredicted\n", stats.orientationBits,
                 stats.orientationMispredicted);
+    std::printf("predictions     %" PRIu64 " edge codes by split direction, %" PRIu64
+                " cell counts and %" PRIu64 " one-vertex splits from the neighbourhood\n",
+                stats.edgeCodesByDirection, stats.countPredictions, stats.positionPredictions);
   }
   std::printf("chunks          %zu\n", decoder.chunks().size());
   std::printf("  %5s %10s %8s %10s\n", "chunk", "offset", "payload", "splits");

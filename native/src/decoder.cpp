@@ -381,7 +381,10 @@ const std::vector<ChunkInfo>& Decoder::chunks() const { return state_->chunks; }
 CodingCost Decoder::cost() const { return state_->cost; }
 const std::vector<uint32_t>& Decoder::vertexParents() const { return state_->parents; }
 ConnectivityStatistics Decoder::statistics() const {
-  return state_->splitter ? state_->splitter->statistics() : ConnectivityStatistics{};
+  if (!state_->splitter) return {};
+  ConnectivityStatistics statistics = state_->splitter->statistics();
+  state_->predictor->addStatistics(statistics);
+  return statistics;
 }
 
 DecodeProgress Decoder::progress() const {

@@ -325,6 +325,7 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options) {
   result.cost.connectivityBits = connectivityBits;
   result.cost.geometryBits = coder.cost() - connectivityBits;
   result.statistics = splitter.statistics();
+  predictor.addStatistics(result.statistics);
   report("code", 1);
   if (getenv("KD_LEVELS")) { double m=0,sg=0; for (int l=0;l<schedule.levels;++l){ fprintf(stderr,"L%2d multi %9.0f single %9.0f n %8ld (%.3f)\n",l,multiBits[l],singleBits[l],singleN[l],singleN[l]?singleBits[l]/singleN[l]:0); m+=multiBits[l]; sg+=singleBits[l];} fprintf(stderr,"multi %.3f single %.3f bpv\n", m/header.vertexCount, sg/header.vertexCount);}
 

@@ -123,7 +123,7 @@ int PositionPredictor::contextOf(uint32_t vertex, int level, bool& mirrored) {
   const uint32_t* neighbour = neighbours_.data() + firstNeighbour_[vertex];
   const uint32_t count = firstNeighbour_[vertex + 1] - firstNeighbour_[vertex];
   if (count == 0) return -1;
-  ++predicted_;
+  ++positionPredictions_;
   Neighbourhood around;
   centre(places_[vertex], around.at);
   for (uint32_t i = 0; i < count; ++i) {
@@ -149,6 +149,7 @@ int PositionPredictor::countContext(SimplexStore& store, uint32_t vertex, int le
   });
   mirrored = false;
   if (around.count == 0) return 0;
+  ++countPredictions_;
   const Features f = features(around, level);
   mirrored = f.mirrored;
   if (!f.hasPlane) {

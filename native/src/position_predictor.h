@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "count_coder.h"
+#include "kdmesh/kdmesh.h"
 #include "range_coder.h"
 #include "simplex_store.h"
 #include "split_schedule.h"
@@ -111,8 +112,11 @@ class PositionPredictor {
     return squared > 0 ? to[axis_[size_t(level)]] / std::sqrt(squared) : 0;
   }
 
-  // Statistics for `kdmesh info`: one-vertex splits coded with a prediction.
-  uint64_t predictedSplits() const { return predicted_; }
+  // Adds the prediction counters to `statistics`.
+  void addStatistics(ConnectivityStatistics& statistics) const {
+    statistics.countPredictions += countPredictions_;
+    statistics.positionPredictions += positionPredictions_;
+  }
 
  private:
   struct Place {
@@ -152,7 +156,8 @@ class PositionPredictor {
   // incidence lists would chain them.
   std::vector<uint32_t> firstNeighbour_, neighbours_;
   std::vector<BitModel> models_;
-  uint64_t predicted_ = 0;
+  mutable uint64_t countPredictions_ = 0;
+  uint64_t positionPredictions_ = 0;
 };
 
 }  // namespace kdmesh

@@ -94,6 +94,7 @@ void VertexSplitter::classifyEdges(uint32_t v, int level) {
     return;
   }
   cosines_.resize(last - first);
+  statistics_.edgeCodesByDirection += last - first;
   double smallest = 2, second = 2;
   for (size_t i = first; i < last; ++i) {
     const double cosine = geometry_.axisCosine(v, star_[i].others[0], level);

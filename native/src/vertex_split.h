@@ -157,6 +157,7 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, Ora
   ++statistics_.vertexSplits;
   linkFans();
   int cutEdges = 0;  // edges coded 4 so far: an edge expansion has two
+  bool codedThree = false;
   for (Entry& entry : star_) {
     entry.record = oracle();
     const uint8_t possible = possibleCodes(entry);
@@ -166,6 +167,7 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, Ora
         entry.dimension == 1 ? edgeModels_[std::min(cutEdges, 2)][entry.fanCodes][entry.geometry]
                              : codeModels_[entry.dimension],
         possible, uint8_t((entry.record & split_record::kCodeMask) + 1));
+    codedThree |= entry.code == 3;
     if (entry.dimension == 1) {
       cutEdges += entry.code == 4;
       const uint8_t bit = uint8_t(1u << std::min(entry.code - 1, 2));
@@ -175,6 +177,7 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, Ora
     ++statistics_.codes[entry.dimension][entry.code - 1];
   }
 
+  statistics_.edgeExpansions += star_[0].code == 4 && cutEdges == 2 && !codedThree;
   for (int d = 1; d <= SimplexStore::kMaxDimension; ++d) store_.detach(d, v);
   if (star_[0].code == 4) {
     const uint32_t edge[2] = {v, v2};

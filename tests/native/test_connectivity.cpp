@@ -39,6 +39,35 @@ TEST(Connectivity, ClosedManifoldMeshes) {
   expectExactRoundTrip(sphereMesh(9, 14));
 }
 
+// Every prediction path runs, and the decoder takes the same paths as the
+// encoder (its counters come from its own replay of the stream).
+TEST(Connectivity, PredictorsRunAlikeOnBothSides) {
+  struct Case {
+    Complex complex;
+    bool surface;
+  };
+  const Case cases[] = {{sphereMesh(12, 18), true}, {gridWithHoles(16), true}, {tetrahedralBlock(4, 5), false}};
+  for (const Case& c : cases) {
+    EncodeOptions options;
+    options.bits = 12;
+    EncodeResult encoded;
+    roundTrip(c.complex, options, &encoded);
+    Decoder decoder;
+    ASSERT_TRUE(decoder.push(encoded.bytes.data(), encoded.bytes.size()).ok());
+    const ConnectivityStatistics& mine = encoded.statistics;
+    const ConnectivityStatistics theirs = decoder.statistics();
+    EXPECT_GT(mine.edgeCodesByDirection, 0u);
+    EXPECT_GT(mine.countPredictions, 0u);
+    EXPECT_GT(mine.positionPredictions, 0u);
+    EXPECT_EQ(theirs.edgeCodesByDirection, mine.edgeCodesByDirection);
+    EXPECT_EQ(theirs.countPredictions, mine.countPredictions);
+    EXPECT_EQ(theirs.positionPredictions, mine.positionPredictions);
+    EXPECT_EQ(theirs.edgeExpansions, mine.edgeExpansions);
+    // Surfaces split mostly by edge expansions.
+    if (c.surface) EXPECT_GT(mine.edgeExpansions * 2, mine.vertexSplits);
+  }
+}
+
 TEST(Connectivity, OpenMeshWithHoles) { expectExactRoundTrip(gridWithHoles(18)); }
 
 TEST(Connectivity, NonManifoldEdgesAndVertexTouchingSheets) {

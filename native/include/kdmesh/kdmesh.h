@@ -167,6 +167,13 @@ struct ConnectivityStatistics {
   std::array<std::array<uint64_t, 4>, 4> codes{};
   uint64_t orientationBits = 0;          // orientation decisions coded
   uint64_t orientationMispredicted = 0;  // of which the prediction was wrong
+  // Vertex splits shaped as an edge expansion: the new edge V1V2, exactly
+  // two edges coded 4 and no simplex coded 3 (the paper's cheap operator).
+  uint64_t edgeExpansions = 0;
+  // Predictions from the current complex (docs/FORMAT.md, "Contexts"):
+  uint64_t edgeCodesByDirection = 0;  // edge codes conditioned on the split direction
+  uint64_t countPredictions = 0;      // several-vertex cell counts with a neighbourhood class
+  uint64_t positionPredictions = 0;   // one-vertex cell splits coded from the neighbours
 };
 
 struct EncodeResult {
