@@ -9,7 +9,7 @@
 //   - the node of the bisection tree (the decisions taken so far),
 //   - and, for populations up to 15 in a complex, a geometry class from the
 //     cell's neighbourhood (PositionPredictor::countContext), in place of
-//     the parent's split.
+//     the level and the parent's split.
 // After six decisions the few remaining candidates of a large cell are nearly
 // equiprobable and are coded uniformly.
 #pragma once
@@ -26,8 +26,7 @@ class CountCoder {
   // `geometryClasses`: how many classes code() may be given (0 for none).
   CountCoder(int levels, int geometryClasses) : levels_(levels < 1 ? 1 : levels) {
     models_.resize(size_t(levels_) * kParentClasses * kContextsPerLevel);
-    geometryModels_.resize(size_t(levels_) * size_t(geometryClasses) * kSmallNodes);
-    geometryClasses_ = geometryClasses;
+    geometryModels_.resize(size_t(geometryClasses) * kSmallNodes);
   }
 
   // The count of a one-vertex cell, 1 when the vertex is in the first half;
@@ -47,8 +46,7 @@ class CountCoder {
                 uint32_t firstHalf, int geometryClass = 0) {
     BitModel* models =
         geometryClass > 0 && population <= kExactPopulations
-            ? &geometryModels_[(size_t(level) * size_t(geometryClasses_) + size_t(geometryClass)) * kSmallNodes +
-                               populationOffset(population)]
+            ? &geometryModels_[size_t(geometryClass) * kSmallNodes + populationOffset(population)]
             : &models_[(size_t(level) * kParentClasses + parentOneSided) * kContextsPerLevel +
                        populationOffset(population)];
     uint32_t low = 0, candidates = population + 1, node = 1;
@@ -91,7 +89,6 @@ class CountCoder {
   }
 
   int levels_;
-  int geometryClasses_ = 0;
   std::vector<BitModel> models_, geometryModels_;
 };
 

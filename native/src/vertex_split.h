@@ -93,7 +93,7 @@ class VertexSplitter {
   void classifyEdges(uint32_t v, int level);
   void linkFans();
   template <class Coder>
-  uint8_t codeSymbol(Coder& coder, BitModel (&models)[16][3], uint8_t possible, uint8_t code);
+  uint8_t codeSymbol(Coder& coder, BitModel (&models)[3], uint8_t possible, uint8_t code);
   template <class Coder>
   void decideOrientation(Coder& coder, int dimension, uint32_t simplex, bool isCopy, uint8_t target);
   int predictFlip(int dimension, uint32_t simplex, int& voteClass);
@@ -109,23 +109,24 @@ class VertexSplitter {
   std::array<std::vector<uint32_t>, 4> around_;
   std::array<bool, 4> aroundReady_{};
   const std::vector<uint32_t>& around(int dimension);
-  // Code models: [dimension][possible set][step of the sequential binarisation];
-  // edges have theirs per geometry class instead of dimension.
+  // Code models: [dimension][possible set][step of the sequential binarisation].
   static constexpr int kEdgeClasses = 25;
   BitModel codeModels_[4][16][3];
-  BitModel edgeModels_[3][8][kEdgeClasses][16][3];  // [cut edges so far][fan codes][class]
+  // Edges: [cut edges so far][fan codes][class][all four codes possible]
+  // (an edge's only face is the vertex, coded 3 or 4, so it has two sets).
+  BitModel edgeModels_[3][8][kEdgeClasses][2][3];
   // Orientation models: [dimension - 2][copy or new][vote class][face of higher].
   BitModel orientationModels_[2][2][3][2];
   ConnectivityStatistics statistics_;
 };
 
 template <class Coder>
-uint8_t VertexSplitter::codeSymbol(Coder& coder, BitModel (&models)[16][3], uint8_t possible, uint8_t code) {
+uint8_t VertexSplitter::codeSymbol(Coder& coder, BitModel (&models)[3], uint8_t possible, uint8_t code) {
   int step = 0;
   for (uint8_t c = 1; c <= 4; ++c) {
     if (!(possible & (1u << (c - 1)))) continue;
     if ((possible >> c) == 0) return c;  // the last candidate left
-    if (coder.bit(models[possible][step], c == code)) return c;
+    if (coder.bit(models[step], c == code)) return c;
     ++step;
   }
   return 0;  // unreachable: `possible` is never empty here
@@ -164,8 +165,9 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, Ora
     if (possible == 0) return false;
     entry.code = codeSymbol(
         coder,
-        entry.dimension == 1 ? edgeModels_[std::min(cutEdges, 2)][entry.fanCodes][entry.geometry]
-                             : codeModels_[entry.dimension],
+        entry.dimension == 1
+            ? edgeModels_[std::min(cutEdges, 2)][entry.fanCodes][entry.geometry][possible == 0b1111]
+            : codeModels_[entry.dimension][possible],
         possible, uint8_t((entry.record & split_record::kCodeMask) + 1));
     codedThree |= entry.code == 3;
     if (entry.dimension == 1) {
