@@ -133,12 +133,13 @@ struct Decoder::State {
         return Status::error(ErrorCode::CorruptChunk,
                              where + ": more splits than the kd-tree has cells");
       if (cursor < cells.size()) {
+        if (connectivity && cursor == 0 && level < schedule->levels) predictor->snapshotNeighbours(store);
         if (!splitCell(cells[cursor++]))
           return Status::error(ErrorCode::CorruptChunk, where + ": inconsistent connectivity codes");
         --left;
       } else {
         const size_t count = std::min<size_t>(left, singleLevelEnd - singleCursor);
-        if (connectivity && singleCursor == 0 && count > 0) predictor->beginSingles(store);
+        if (connectivity && singleCursor == 0 && count > 0) predictor->snapshotNeighbours(store);
         refineSingles(singleCursor, singleCursor + count);
         singleCursor += count;
         left -= uint32_t(count);
@@ -175,7 +176,7 @@ struct Decoder::State {
     uint32_t firstHalf = population / 2;
     if (geometric) {
       bool mirrored = false;
-      const int geometryClass = connectivity ? predictor->countContext(store, cell.vertex, level, mirrored) : 0;
+      const int geometryClass = connectivity ? predictor->countContext(cell.vertex, level, mirrored) : 0;
       firstHalf = counts->code(coder, population, level, cell.parentOneSided, 0, geometryClass);
       if (mirrored) firstHalf = population - firstHalf;
     }

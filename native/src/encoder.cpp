@@ -111,8 +111,9 @@ class ChunkWriter {
 // The visitor sees cell(level, geometric, population, firstHalf,
 // parentOneSided, keptId, addedId) for cells of several vertices (addedId is
 // kNoSimplex for a one-sided split), placed(id, prefix, level) for each
-// non-empty half of a geometric split, singlesBegin() before the one-vertex
-// cells of a level, single(level, parentOneSided,
+// non-empty half of a geometric split, cellsBegin() and singlesBegin()
+// before the cells of several vertices and of one vertex of a geometric
+// level, single(level, parentOneSided,
 // inFirstHalf, id) for one-vertex cells, named(keyIndex, id) when a vertex
 // gets its final id, and splitDone() after each split.
 template <class Visitor>
@@ -146,6 +147,7 @@ void traverseKdTree(const std::vector<KdKey>& keys, const SplitSchedule& schedul
     const size_t oldSingles = singles.size();
     const size_t singleLevelEnd = geometric ? oldSingles : 0;
     children.clear();
+    if (geometric && !cells.empty()) visitor.cellsBegin();
     for (const Cell& cell : cells) {
       const uint32_t population = cell.end - cell.begin;
       const uint32_t split =
@@ -234,6 +236,7 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options) {
         if (added != kNoSimplex) splits.push_back({kept, added});
       }
       void placed(uint32_t, const uint32_t*, int) {}
+      void cellsBegin() {}
       void singlesBegin() {}
       void single(int, bool, bool, uint32_t) {}
       void named(uint32_t key, uint32_t id) { ids[vertexOfKey[key]] = id; }
@@ -289,7 +292,7 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options) {
       { double b0 = coder.cost();
       if (geometric) {
         bool mirrored = false;
-        const int geometryClass = connectivity ? predictor.countContext(forward, kept, level, mirrored) : 0;
+        const int geometryClass = connectivity ? predictor.countContext(kept, level, mirrored) : 0;
         counts.code(coder, population, level, parentOneSided, mirrored ? population - firstHalf : firstHalf,
                     geometryClass);
       }
@@ -304,8 +307,11 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options) {
     void placed(uint32_t id, const uint32_t* prefix, int level) {
       if (connectivity) predictor.place(id, prefix, level);
     }
+    void cellsBegin() {
+      if (connectivity) predictor.snapshotNeighbours(forward);
+    }
     void singlesBegin() {
-      if (connectivity) predictor.beginSingles(forward);
+      if (connectivity) predictor.snapshotNeighbours(forward);
     }
     void single(int level, bool parentOneSided, bool inFirstHalf, uint32_t id) {
       double b0 = coder.cost();

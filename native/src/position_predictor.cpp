@@ -48,7 +48,7 @@ void PositionPredictor::centre(const Place& place, double out[3]) const {
   for (int a = 0; a < 3; ++a) out[a] = double(place.prefix[a]) * width[size_t(a)] + (width[size_t(a)] - 1) * 0.5;
 }
 
-void PositionPredictor::beginSingles(const SimplexStore& store) {
+void PositionPredictor::snapshotNeighbours(const SimplexStore& store) {
   const uint32_t vertexCount = uint32_t(places_.size());
   firstNeighbour_.assign(size_t(vertexCount) + 1, 0);
   const uint32_t edges = store.size(1);
@@ -67,26 +67,6 @@ void PositionPredictor::beginSingles(const SimplexStore& store) {
   // The fill advanced each start to the next row's; shift them back.
   for (uint32_t v = vertexCount; v > 0; --v) firstNeighbour_[v] = firstNeighbour_[v - 1];
   firstNeighbour_[0] = 0;
-}
-
-void PositionPredictor::Neighbourhood::add(const double position[3]) {
-  double p[3];
-  for (int a = 0; a < 3; ++a) {
-    p[a] = position[a] - at[a];
-    sum[a] += p[a];
-    squaredDistance += p[a] * p[a];
-  }
-  // The plane's orientation does not matter, so neighbours need no order:
-  // the normal sums the cross products of the offsets of consecutive
-  // neighbours, each turned to agree with the sum so far.
-  if (count > 0) {
-    const double cross[3] = {previous[1] * p[2] - previous[2] * p[1], previous[2] * p[0] - previous[0] * p[2],
-                             previous[0] * p[1] - previous[1] * p[0]};
-    const double sign = cross[0] * normal[0] + cross[1] * normal[1] + cross[2] * normal[2] < 0 ? -1 : 1;
-    for (int a = 0; a < 3; ++a) normal[a] += sign * cross[a];
-  }
-  for (int a = 0; a < 3; ++a) previous[a] = p[a];
-  ++count;
 }
 
 PositionPredictor::Features PositionPredictor::features(const Neighbourhood& around, int level) const {
@@ -119,18 +99,23 @@ PositionPredictor::Features PositionPredictor::features(const Neighbourhood& aro
   return f;
 }
 
-int PositionPredictor::contextOf(uint32_t vertex, int level, bool& mirrored) {
+bool PositionPredictor::gather(uint32_t vertex, Neighbourhood& around) const {
+  if (size_t(vertex) + 1 >= firstNeighbour_.size()) return false;
   const uint32_t* neighbour = neighbours_.data() + firstNeighbour_[vertex];
   const uint32_t count = firstNeighbour_[vertex + 1] - firstNeighbour_[vertex];
-  if (count == 0) return -1;
-  ++positionPredictions_;
-  Neighbourhood around;
   centre(places_[vertex], around.at);
   for (uint32_t i = 0; i < count; ++i) {
     double p[3];
     centre(places_[neighbour[i]], p);
     around.add(p);
   }
+  return count > 0;
+}
+
+int PositionPredictor::contextOf(uint32_t vertex, int level, bool& mirrored) {
+  Neighbourhood around;
+  if (!gather(vertex, around)) return -1;
+  ++positionPredictions_;
   const Features f = features(around, level);
   mirrored = f.mirrored;
   const int tilt = f.hasPlane ? tiltClass(f.tilt) : kTiltClasses - 1;
@@ -139,16 +124,10 @@ int PositionPredictor::contextOf(uint32_t vertex, int level, bool& mirrored) {
          centroidBucket(f.centroidOffset);
 }
 
-int PositionPredictor::countContext(SimplexStore& store, uint32_t vertex, int level, bool& mirrored) const {
+int PositionPredictor::countContext(uint32_t vertex, int level, bool& mirrored) const {
   Neighbourhood around;
-  centre(places_[vertex], around.at);
-  store.forEachIncident(1, vertex, [&](uint32_t edge, uint32_t position) {
-    double p[3];
-    centre(places_[store.vertices(1, edge)[1 - position]], p);
-    around.add(p);
-  });
   mirrored = false;
-  if (around.count == 0) return 0;
+  if (!gather(vertex, around)) return 0;
   ++countPredictions_;
   const Features f = features(around, level);
   mirrored = f.mirrored;

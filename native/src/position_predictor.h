@@ -51,9 +51,12 @@ class PositionPredictor {
     state.level = uint32_t(level);
   }
 
-  // Call before the one-vertex cells of a level split; `store` must not
-  // change until they all have.
-  void beginSingles(const SimplexStore& store);
+  // Takes the neighbour lists of `store`'s vertices, for the predictions
+  // until the next snapshot. Call when the cells of several vertices of a
+  // geometric level start splitting (their counts are then predicted from
+  // the complex as it was at the start of the level) and again when its
+  // one-vertex cells do (the complex does not change while they split).
+  void snapshotNeighbours(const SimplexStore& store);
 
   // Geometry class (0..kCountClasses-1) of the split of a cell of several
   // vertices at `level` whose vertex in the complex is `vertex`: how close
@@ -61,7 +64,7 @@ class PositionPredictor {
   // the centroid alone without a plane, 0 without neighbours). With
   // `mirrored` the prediction favours the first half.
   static constexpr int kCountClasses = 9;
-  int countContext(SimplexStore& store, uint32_t vertex, int level, bool& mirrored) const;
+  int countContext(uint32_t vertex, int level, bool& mirrored) const;
 
   // Hints that `vertex` will be coded `distance` one-vertex splits from now
   // (24, 16 and 8 walk the three levels of indirection of its neighbours'
@@ -130,7 +133,25 @@ class PositionPredictor {
     double sum[3] = {0, 0, 0}, normal[3] = {0, 0, 0}, previous[3] = {0, 0, 0};
     double squaredDistance = 0;
     uint32_t count = 0;
-    void add(const double position[3]);
+    void add(const double position[3]) {
+      double p[3];
+      for (int a = 0; a < 3; ++a) {
+        p[a] = position[a] - at[a];
+        sum[a] += p[a];
+        squaredDistance += p[a] * p[a];
+      }
+      // The plane's orientation does not matter, so neighbours need no
+      // order: the normal sums the cross products of the offsets of
+      // consecutive neighbours, each turned to agree with the sum so far.
+      if (count > 0) {
+        const double cross[3] = {previous[1] * p[2] - previous[2] * p[1], previous[2] * p[0] - previous[0] * p[2],
+                                 previous[0] * p[1] - previous[1] * p[0]};
+        const double sign = cross[0] * normal[0] + cross[1] * normal[1] + cross[2] * normal[2] < 0 ? -1 : 1;
+        for (int a = 0; a < 3; ++a) normal[a] += sign * cross[a];
+      }
+      for (int a = 0; a < 3; ++a) previous[a] = p[a];
+      ++count;
+    }
   };
   // The predictions against the split at `level`, in half widths of the
   // cell along the split axis, mirrored so that the plane (or without one,
@@ -143,17 +164,18 @@ class PositionPredictor {
     bool hasPlane = false, mirrored = false;
   };
   Features features(const Neighbourhood& around, int level) const;
+  // Sums the neighbours of `vertex` in the snapshot; false without any.
+  bool gather(uint32_t vertex, Neighbourhood& around) const;
   int contextOf(uint32_t vertex, int level, bool& mirrored);
   void centre(const Place& place, double out[3]) const;
 
   std::vector<uint8_t> axis_;                  // split axis per level
   std::vector<std::array<double, 3>> width_;   // cell width per level and axis
   std::vector<Place> places_;
-  // The current complex's edges as neighbour lists (compressed rows),
-  // rebuilt when a level's one-vertex cells start splitting: the complex
-  // does not change while they do, and contiguous lists let the lookups of
-  // a vertex's neighbours proceed in parallel, where the store's linked
-  // incidence lists would chain them.
+  // The complex's edges as neighbour lists (compressed rows) at the last
+  // snapshot: contiguous lists let the lookups of a vertex's neighbours
+  // proceed in parallel, where the store's linked incidence lists would
+  // chain them.
   std::vector<uint32_t> firstNeighbour_, neighbours_;
   std::vector<BitModel> models_;
   mutable uint64_t countPredictions_ = 0;
