@@ -215,9 +215,6 @@ struct Decoder::State {
   void refineSingles(size_t begin, size_t end) {
     const int axis = schedule->axis[size_t(level)];
     for (size_t i = begin; i < end; ++i) {
-      if (connectivity)
-        for (const size_t ahead : {24, 16, 8})
-          if (i + ahead < singleLevelEnd) predictor->prefetch(singles[i + ahead].vertex, int(ahead));
       Cell& cell = singles[i];
       const bool upperHalf =
           connectivity ? !predictor->codeSingle(coder, *counts, cell.vertex, level,

@@ -66,21 +66,6 @@ class PositionPredictor {
   static constexpr int kCountClasses = 9;
   int countContext(uint32_t vertex, int level, bool& mirrored) const;
 
-  // Hints that `vertex` will be coded `distance` one-vertex splits from now
-  // (24, 16 and 8 walk the three levels of indirection of its neighbours'
-  // cells). A memory prefetch only: coding does not depend on it.
-  void prefetch(uint32_t vertex, int distance) const {
-    if (distance == 24) {
-      __builtin_prefetch(&firstNeighbour_[vertex]);
-      __builtin_prefetch(&places_[vertex]);
-    } else if (distance == 16) {
-      __builtin_prefetch(&neighbours_[firstNeighbour_[vertex]]);
-    } else {
-      for (uint32_t i = firstNeighbour_[vertex]; i < firstNeighbour_[vertex + 1]; ++i)
-        __builtin_prefetch(&places_[neighbours_[i]]);
-    }
-  }
-
   // Codes whether the vertex of a one-vertex cell at `level` lies in its
   // first half, and moves the vertex's cell to that half. A vertex without
   // neighbours falls back to `counts`. Returns the (decoded) bit.
@@ -146,7 +131,8 @@ class PositionPredictor {
       if (count > 0) {
         const double cross[3] = {previous[1] * p[2] - previous[2] * p[1], previous[2] * p[0] - previous[0] * p[2],
                                  previous[0] * p[1] - previous[1] * p[0]};
-        const double sign = cross[0] * normal[0] + cross[1] * normal[1] + cross[2] * normal[2] < 0 ? -1 : 1;
+        // copysign, not a branch: the signs are a coin toss for the branch predictor.
+        const double sign = std::copysign(1.0, cross[0] * normal[0] + cross[1] * normal[1] + cross[2] * normal[2]);
         for (int a = 0; a < 3; ++a) normal[a] += sign * cross[a];
       }
       for (int a = 0; a < 3; ++a) previous[a] = p[a];
