@@ -84,8 +84,9 @@ uint8_t VertexSplitter::possibleCodes(const Entry& entry) const {
 // Where each edge's other vertex lies against the split: the cosine of the
 // angle between the split axis and the direction from v's cell centre to
 // it. Negative cosines point to v's half, positive ones to v2's; the two
-// edges that become triangles (code 4) of an edge expansion are usually the
-// two closest to the split plane, hence the rank of |cosine| as well.
+// edges that become triangles (code 4) of an edge expansion lie where the
+// fan crosses the split plane, hence whether a fan neighbour lies on the
+// other side, and which of the two is closer to the plane.
 // Class 0: no geometry (splits of coincident vertices).
 void VertexSplitter::classifyEdges(uint32_t v, int level) {
   const size_t first = begin_[1], last = begin_[2];
@@ -95,23 +96,21 @@ void VertexSplitter::classifyEdges(uint32_t v, int level) {
   }
   cosines_.resize(last - first);
   statistics_.edgeCodesByDirection += last - first;
-  double smallest = 2, second = 2;
-  for (size_t i = first; i < last; ++i) {
-    const double cosine = geometry_.axisCosine(v, star_[i].others[0], level);
-    cosines_[i - first] = cosine;
-    const double magnitude = std::fabs(cosine);
-    if (magnitude < smallest) {
-      second = smallest;
-      smallest = magnitude;
-    } else if (magnitude < second) {
-      second = magnitude;
-    }
-  }
+  for (size_t i = first; i < last; ++i) cosines_[i - first] = geometry_.axisCosine(v, star_[i].others[0], level);
   for (size_t i = first; i < last; ++i) {
     const double cosine = cosines_[i - first], magnitude = std::fabs(cosine);
-    const int rank = magnitude <= smallest ? 0 : magnitude <= second ? 1 : 2;
     const int bucket = magnitude < 0.2 ? 0 : magnitude < 0.45 ? 1 : magnitude < 0.7 ? 2 : 3;
-    star_[i].geometry = uint8_t(1 + (rank * 2 + (cosine > 0)) * 4 + bucket);
+    // Between a fan neighbour on v's side and one on v2's side lies a cut
+    // edge: likely the one of the two closer to the split plane.
+    int crossing = 0;
+    for (const uint32_t neighbour : star_[i].fan) {
+      if (neighbour == kNoSimplex) continue;
+      const double theirs = cosines_[neighbour - first];
+      if ((theirs > 0) == (cosine > 0)) continue;
+      crossing = magnitude <= std::fabs(theirs) ? 1 : std::max(crossing, 2);
+      if (crossing == 1) break;
+    }
+    star_[i].geometry = uint8_t(1 + (crossing * 2 + (cosine > 0)) * 4 + bucket);
   }
 }
 

@@ -154,9 +154,9 @@ void VertexSplitter::decideOrientation(Coder& coder, int dimension, uint32_t sim
 template <class Coder, class Oracle>
 bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, Oracle&& oracle) {
   gatherStar(store_, v, star_, begin_);
+  linkFans();
   classifyEdges(v, level);
   ++statistics_.vertexSplits;
-  linkFans();
   int cutEdges = 0;  // edges coded 4 so far: an edge expansion has two
   bool codedThree = false;
   for (Entry& entry : star_) {
