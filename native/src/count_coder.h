@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "model_priors.h"
 #include "range_coder.h"
 
 namespace kdmesh {
@@ -27,7 +28,11 @@ class CountCoder {
   CountCoder(int levels, int geometryClasses) : levels_(levels < 1 ? 1 : levels) {
     models_.resize(size_t(levels_) * kParentClasses * kContextsPerLevel);
     geometryModels_.resize(size_t(geometryClasses) * kSmallNodes);
+    if (geometryModels_.size() == kFamilySize[int(ModelFamily::CellCounts)])
+      primeModels(ModelFamily::CellCounts, geometryModels_.data());
   }
+
+  const std::vector<BitModel>& geometryModels() const { return geometryModels_; }
 
   // The count of a one-vertex cell, 1 when the vertex is in the first half;
   // the same model as code() with population 1, in a loop-free form.

@@ -8,6 +8,7 @@
 #include "count_coder.h"
 #include "crc32.h"
 #include "decimation.h"
+#include "encoder_internal.h"
 #include "kd_order.h"
 #include "kdmesh/kdmesh.h"
 #include "position_predictor.h"
@@ -201,6 +202,10 @@ struct RecordReader {
 }  // namespace
 
 EncodeResult encode(const Complex& complex, const EncodeOptions& options) {
+  return encode(complex, options, nullptr);
+}
+
+EncodeResult encode(const Complex& complex, const EncodeOptions& options, TrainedModels* finalModels) {
   EncodeResult result;
   if (result.status = checkOptions(complex, options); !result.status.ok()) return result;
   auto report = [&](const char* phase, double fraction) {
@@ -331,6 +336,13 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options) {
   result.cost.connectivityBits = connectivityBits;
   result.cost.geometryBits = coder.cost() - connectivityBits;
   result.statistics = splitter.statistics();
+  if (finalModels && connectivity) {
+    finalModels->families[int(ModelFamily::OneVertexSplits)] = predictor.models();
+    const BitModel* edges = splitter.edgeModels();
+    finalModels->families[int(ModelFamily::EdgeCodes)].assign(
+        edges, edges + kFamilySize[int(ModelFamily::EdgeCodes)]);
+    finalModels->families[int(ModelFamily::CellCounts)] = counts.geometryModels();
+  }
   predictor.addStatistics(result.statistics);
   report("code", 1);
   if (getenv("KD_LEVELS")) { double m=0,sg=0; for (int l=0;l<schedule.levels;++l){ fprintf(stderr,"L%2d multi %9.0f single %9.0f n %8ld (%.3f)\n",l,multiBits[l],singleBits[l],singleN[l],singleN[l]?singleBits[l]/singleN[l]:0); m+=multiBits[l]; sg+=singleBits[l];} fprintf(stderr,"multi %.3f single %.3f bpv\n", m/header.vertexCount, sg/header.vertexCount);}

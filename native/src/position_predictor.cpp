@@ -1,5 +1,7 @@
 #include "position_predictor.h"
 
+#include "model_priors.h"
+
 #include <cmath>
 
 namespace kdmesh {
@@ -36,6 +38,9 @@ int centroidBucket(double t) {
 PositionPredictor::PositionPredictor(const SplitSchedule& schedule)
     : axis_(schedule.axis),
       models_(size_t(kScaleClasses) * kTiltClasses * kPlaneBuckets * kCentroidBuckets) {
+  static_assert(size_t(kScaleClasses) * kTiltClasses * kPlaneBuckets * kCentroidBuckets ==
+                kFamilySize[int(ModelFamily::OneVertexSplits)]);
+  primeModels(ModelFamily::OneVertexSplits, models_.data());
   width_.resize(size_t(schedule.levels) + 1);
   for (size_t level = 0; level < width_.size(); ++level)
     for (int a = 0; a < 3; ++a)

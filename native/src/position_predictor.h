@@ -100,6 +100,8 @@ class PositionPredictor {
     return squared > 0 ? to[axis_[size_t(level)]] / std::sqrt(squared) : 0;
   }
 
+  const std::vector<BitModel>& models() const { return models_; }
+
   // Adds the prediction counters to `statistics`.
   void addStatistics(ConnectivityStatistics& statistics) const {
     statistics.countPredictions += countPredictions_;

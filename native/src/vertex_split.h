@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "kdmesh/kdmesh.h"
+#include "model_priors.h"
 #include "position_predictor.h"
 #include "range_coder.h"
 #include "simplex_store.h"
@@ -71,7 +72,10 @@ class VertexSplitter {
   // geometric level puts v in its first half and v2 in the second, which
   // predicts where v's edges go.
   VertexSplitter(SimplexStore& store, const PositionPredictor& geometry)
-      : store_(store), geometry_(geometry) {}
+      : store_(store), geometry_(geometry) {
+    static_assert(sizeof(edgeModels_) / sizeof(BitModel) == kFamilySize[int(ModelFamily::EdgeCodes)]);
+    primeModels(ModelFamily::EdgeCodes, edgeModels());
+  }
 
   // Splits `v`, whose cell is at `level`, into `v` and `v2`. `next()` of the
   // oracle gives the record byte of each star entry in canonical order.
@@ -81,6 +85,7 @@ class VertexSplitter {
   bool split(Coder& coder, uint32_t v, uint32_t v2, int level, Oracle&& oracle);
 
   const ConnectivityStatistics& statistics() const { return statistics_; }
+  BitModel* edgeModels() { return &edgeModels_[0][0][0][0][0]; }
 
  private:
   using Entry = StarEntry;
