@@ -342,6 +342,8 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
     finalModels->families[int(ModelFamily::EdgeCodes)].assign(
         edges, edges + kFamilySize[int(ModelFamily::EdgeCodes)]);
     finalModels->families[int(ModelFamily::CellCounts)] = counts.geometryModels();
+    finalModels->families[int(ModelFamily::OneVertexByPlane)] = predictor.planeModels();
+    finalModels->families[int(ModelFamily::OneVertexByCentroid)] = predictor.centroidModels();
   }
   predictor.addStatistics(result.statistics);
   report("code", 1);

@@ -18,9 +18,9 @@
 
 namespace kdmesh {
 
-enum class ModelFamily { OneVertexSplits, EdgeCodes, CellCounts };
-constexpr int kModelFamilies = 3;
-constexpr std::array<size_t, kModelFamilies> kFamilySize = {1500, 3600, 1530};
+enum class ModelFamily { OneVertexSplits, EdgeCodes, CellCounts, OneVertexByPlane, OneVertexByCentroid };
+constexpr int kModelFamilies = 5;
+constexpr std::array<size_t, kModelFamilies> kFamilySize = {1500, 3600, 1530, 150, 50};
 
 // As many observations as a prior is worth: the slow estimator then starts
 // at a moderate rate and still follows the model at hand.

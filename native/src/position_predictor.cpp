@@ -37,10 +37,18 @@ int centroidBucket(double t) {
 
 PositionPredictor::PositionPredictor(const SplitSchedule& schedule)
     : axis_(schedule.axis),
-      models_(size_t(kScaleClasses) * kTiltClasses * kPlaneBuckets * kCentroidBuckets) {
+      models_(size_t(kScaleClasses) * kTiltClasses * kPlaneBuckets * kCentroidBuckets),
+      planeModels_(size_t(kScaleClasses) * kTiltClasses * kPlaneBuckets),
+      centroidModels_(size_t(kScaleClasses) * kCentroidBuckets),
+      // The joint model is the sharpest; the others help while it learns.
+      mixer_(kScaleClasses, {39322, 19661, 19661}) {
   static_assert(size_t(kScaleClasses) * kTiltClasses * kPlaneBuckets * kCentroidBuckets ==
                 kFamilySize[int(ModelFamily::OneVertexSplits)]);
+  static_assert(size_t(kScaleClasses) * kTiltClasses * kPlaneBuckets == kFamilySize[int(ModelFamily::OneVertexByPlane)]);
+  static_assert(size_t(kScaleClasses) * kCentroidBuckets == kFamilySize[int(ModelFamily::OneVertexByCentroid)]);
   primeModels(ModelFamily::OneVertexSplits, models_.data());
+  primeModels(ModelFamily::OneVertexByPlane, planeModels_.data());
+  primeModels(ModelFamily::OneVertexByCentroid, centroidModels_.data());
   width_.resize(size_t(schedule.levels) + 1);
   for (size_t level = 0; level < width_.size(); ++level)
     for (int a = 0; a < 3; ++a)
@@ -117,16 +125,19 @@ bool PositionPredictor::gather(uint32_t vertex, Neighbourhood& around) const {
   return count > 0;
 }
 
-int PositionPredictor::contextOf(uint32_t vertex, int level, bool& mirrored) {
+bool PositionPredictor::contextsOf(uint32_t vertex, int level, SingleContexts& c) {
   Neighbourhood around;
-  if (!gather(vertex, around)) return -1;
+  if (!gather(vertex, around)) return false;
   ++positionPredictions_;
   const Features f = features(around, level);
-  mirrored = f.mirrored;
+  c.mirrored = f.mirrored;
   const int tilt = f.hasPlane ? tiltClass(f.tilt) : kTiltClasses - 1;
-  return ((scaleClass(f.meanSquaredDistance) * kTiltClasses + tilt) * kPlaneBuckets + planeBucket(f.planeOffset)) *
-             kCentroidBuckets +
-         centroidBucket(f.centroidOffset);
+  const int scale = scaleClass(f.meanSquaredDistance);
+  c.plane = (scale * kTiltClasses + tilt) * kPlaneBuckets + planeBucket(f.planeOffset);
+  c.joint = c.plane * kCentroidBuckets + centroidBucket(f.centroidOffset);
+  c.centroid = scale * kCentroidBuckets + centroidBucket(f.centroidOffset);
+  c.mixerSet = scale;
+  return true;
 }
 
 int PositionPredictor::countContext(uint32_t vertex, int level, bool& mirrored) const {

@@ -30,6 +30,7 @@
 
 #include "count_coder.h"
 #include "kdmesh/kdmesh.h"
+#include "mixer.h"
 #include "range_coder.h"
 #include "simplex_store.h"
 #include "split_schedule.h"
@@ -72,11 +73,22 @@ class PositionPredictor {
   template <class Coder>
   bool codeSingle(Coder& coder, CountCoder& counts, uint32_t vertex, int level,
                   bool parentOneSided, bool inFirstHalf) {
-    bool mirrored = false;
-    const int context = contextOf(vertex, level, mirrored);
-    const bool first =
-        context < 0 ? counts.codeSingle(coder, level, parentOneSided, inFirstHalf)
-                    : coder.bit(models_[size_t(context)], inFirstHalf != mirrored) != mirrored;
+    SingleContexts c;
+    bool first;
+    if (!contextsOf(vertex, level, c)) {
+      first = counts.codeSingle(coder, level, parentOneSided, inFirstHalf);
+    } else {
+      BitModel& joint = models_[size_t(c.joint)];
+      BitModel& plane = planeModels_[size_t(c.plane)];
+      BitModel& centroid = centroidModels_[size_t(c.centroid)];
+      const uint32_t p0 = mixer_.mix(c.mixerSet, {&joint, &plane, &centroid});
+      const bool bit = coder.bitWithProbability(p0, inFirstHalf != c.mirrored);
+      joint.update(bit);
+      plane.update(bit);
+      centroid.update(bit);
+      mixer_.update(bit);
+      first = bit != c.mirrored;
+    }
     Place& p = places_[vertex];
     const int axis = axis_[size_t(level)];
     p.prefix[axis] = p.prefix[axis] << 1 | uint32_t(!first);
@@ -101,6 +113,8 @@ class PositionPredictor {
   }
 
   const std::vector<BitModel>& models() const { return models_; }
+  const std::vector<BitModel>& planeModels() const { return planeModels_; }
+  const std::vector<BitModel>& centroidModels() const { return centroidModels_; }
 
   // Adds the prediction counters to `statistics`.
   void addStatistics(ConnectivityStatistics& statistics) const {
@@ -154,7 +168,14 @@ class PositionPredictor {
   Features features(const Neighbourhood& around, int level) const;
   // Sums the neighbours of `vertex` in the snapshot; false without any.
   bool gather(uint32_t vertex, Neighbourhood& around) const;
-  int contextOf(uint32_t vertex, int level, bool& mirrored);
+  // The models of a one-vertex split: one for the joint class of all
+  // features, one for the plane's alone, one for the centroid's alone,
+  // mixed with weights chosen by the neighbours' distance.
+  struct SingleContexts {
+    int joint, plane, centroid, mixerSet;
+    bool mirrored;
+  };
+  bool contextsOf(uint32_t vertex, int level, SingleContexts& contexts);
   void centre(const Place& place, double out[3]) const;
 
   std::vector<uint8_t> axis_;                  // split axis per level
@@ -165,7 +186,8 @@ class PositionPredictor {
   // proceed in parallel, where the store's linked incidence lists would
   // chain them.
   std::vector<uint32_t> firstNeighbour_, neighbours_;
-  std::vector<BitModel> models_;
+  std::vector<BitModel> models_, planeModels_, centroidModels_;
+  Mixer<3> mixer_;
   mutable uint64_t countPredictions_ = 0;
   uint64_t positionPredictions_ = 0;
 };

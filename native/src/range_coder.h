@@ -68,7 +68,13 @@ class RangeEncoder {
   explicit RangeEncoder(std::vector<uint8_t>& out) : out_(out) {}
 
   bool bit(BitModel& model, bool value) {
-    const uint32_t p0 = model.probabilityOfZero();
+    bitWithProbability(model.probabilityOfZero(), value);
+    model.update(value);
+    return value;
+  }
+
+  // A bit with P(0) = p0 / 2^15 from elsewhere (a mixer); no model update.
+  bool bitWithProbability(uint32_t p0, bool value) {
     const uint32_t bound = (range_ >> kProbabilityBits) * p0;
     if (measuring_) cost_ += CostTable::bits(value ? kProbabilityOne - p0 : p0);
     if (value) {
@@ -77,7 +83,6 @@ class RangeEncoder {
     } else {
       range_ = bound;
     }
-    model.update(value);
     normalize();
     return value;
   }
@@ -183,7 +188,12 @@ class RangeDecoder {
   }
 
   bool bit(BitModel& model, bool /*unused*/ = false) {
-    const uint32_t p0 = model.probabilityOfZero();
+    const bool value = bitWithProbability(model.probabilityOfZero());
+    model.update(value);
+    return value;
+  }
+
+  bool bitWithProbability(uint32_t p0, bool /*unused*/ = false) {
     const uint32_t bound = (range_ >> kProbabilityBits) * p0;
     bool value;
     if (code_ < bound) {
@@ -195,7 +205,6 @@ class RangeDecoder {
       value = true;
     }
     if (measuring_) cost_ += CostTable::bits(value ? kProbabilityOne - p0 : p0);
-    model.update(value);
     normalize();
     return value;
   }

@@ -17,7 +17,8 @@ namespace {
 
 constexpr double kMaxWeight = 256;
 constexpr const char* kNames[kdmesh::kModelFamilies] = {"kOneVertexSplitPriors", "kEdgeCodePriors",
-                                                         "kCellCountPriors"};
+                                                         "kCellCountPriors", "kOneVertexByPlanePriors",
+                                                         "kOneVertexByCentroidPriors"};
 
 }  // namespace
 

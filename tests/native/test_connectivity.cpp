@@ -64,7 +64,9 @@ TEST(Connectivity, PredictorsRunAlikeOnBothSides) {
     EXPECT_EQ(theirs.positionPredictions, mine.positionPredictions);
     EXPECT_EQ(theirs.edgeExpansions, mine.edgeExpansions);
     // Surfaces split mostly by edge expansions.
-    if (c.surface) EXPECT_GT(mine.edgeExpansions * 2, mine.vertexSplits);
+    if (c.surface) {
+      EXPECT_GT(mine.edgeExpansions * 2, mine.vertexSplits);
+    }
   }
 }
 

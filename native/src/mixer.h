@@ -1,0 +1,84 @@
+// Logistic mixing of binary predictions, in the manner of the PAQ family of
+// compressors: each input model's probability is mapped to the logistic
+// domain (stretched), a weighted sum of them is mapped back (squashed), and
+// the weights learn online, each step following the gradient of the coding
+// cost. Integer arithmetic throughout, so that the encoder and every decoder
+// (native or WebAssembly) agree bit for bit.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "range_coder.h"
+
+namespace kdmesh {
+
+// Probabilities in 12 bits, logistic values in [-2047, 2047] (units of 1/256).
+class Logistic {
+ public:
+  static int squash(int d) {
+    if (d > 2047) d = 2047;
+    if (d < -2047) d = -2047;
+    // 4096 / (1 + e^(-d/256)) at d = -2048, -1920, ..., 2048, rounded.
+    static constexpr int kKnots[33] = {1,    2,    4,    6,    10,   17,   27,   45,   74,   120,  194,
+                                       311,  488,  747,  1102, 1546, 2048, 2550, 2994, 3349, 3608, 3785,
+                                       3902, 3976, 4022, 4051, 4069, 4079, 4086, 4090, 4092, 4094, 4095};
+    const int i = (d + 2048) >> 7, w = (d + 2048) & 127;
+    return (kKnots[i] * (128 - w) + kKnots[i + 1] * w + 64) >> 7;
+  }
+  static int stretch(int p) { return table().stretch[size_t(p)]; }
+
+ private:
+  struct Table {
+    std::array<int16_t, 4096> stretch;
+    // The inverse of squash: for each p, the smallest d with squash(d) >= p.
+    Table() {
+      int p = 0;
+      for (int d = -2047; d <= 2047; ++d)
+        for (const int s = squash(d); p <= s && p < 4096; ++p) stretch[size_t(p)] = int16_t(d);
+      for (; p < 4096; ++p) stretch[size_t(p)] = 2047;
+    }
+  };
+  static const Table& table() {
+    static const Table t;
+    return t;
+  }
+};
+
+// Mixes kInputs models with one of `sets` weight vectors, which start at
+// `initial` (in units of 2^-16).
+template <int kInputs>
+class Mixer {
+ public:
+  Mixer(int sets, const std::array<int32_t, kInputs>& initial) : weights_(size_t(sets), initial) {}
+
+  // P(bit == 0) in units of 2^-15 for the coder.
+  uint32_t mix(int set, const std::array<const BitModel*, kInputs>& inputs) {
+    set_ = set;
+    int64_t dot = 0;
+    for (int i = 0; i < kInputs; ++i) {
+      const int p = int(inputs[size_t(i)]->probabilityOfZero() >> 3);
+      stretched_[size_t(i)] = Logistic::stretch(p < 1 ? 1 : p > 4095 ? 4095 : p);
+      dot += int64_t(weights_[size_t(set)][size_t(i)]) * stretched_[size_t(i)];
+    }
+    mixed_ = Logistic::squash(int(dot >> 16));
+    const uint32_t p0 = uint32_t(mixed_) << 3;
+    return p0 < 64 ? 64 : p0 > kProbabilityOne - 64 ? kProbabilityOne - 64 : p0;
+  }
+
+  void update(bool bit) {
+    // A small rate: the inputs are adaptive models already, the weights
+    // only settle how far to trust each (rates 2^-9 and faster measured worse).
+    const int error = (bit ? 0 : 4095) - mixed_;
+    for (int i = 0; i < kInputs; ++i)
+      weights_[size_t(set_)][size_t(i)] += (stretched_[size_t(i)] * error) >> 10;
+  }
+
+ private:
+  std::vector<std::array<int32_t, kInputs>> weights_;
+  std::array<int, kInputs> stretched_{};
+  int mixed_ = 2048, set_ = 0;
+};
+
+}  // namespace kdmesh
