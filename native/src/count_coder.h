@@ -17,6 +17,7 @@
 #include <cstdint>
 #include <vector>
 
+#include "mixer.h"
 #include "model_priors.h"
 #include "range_coder.h"
 
@@ -25,7 +26,8 @@ namespace kdmesh {
 class CountCoder {
  public:
   // `geometryClasses`: how many classes code() may be given (0 for none).
-  CountCoder(int levels, int geometryClasses) : levels_(levels < 1 ? 1 : levels) {
+  CountCoder(int levels, int geometryClasses)
+      : levels_(levels < 1 ? 1 : levels), mixer_(geometryClasses < 1 ? 1 : geometryClasses, {45875, 19661}) {
     models_.resize(size_t(levels_) * kParentClasses * kContextsPerLevel);
     geometryModels_.resize(size_t(geometryClasses) * kSmallNodes);
     if (geometryModels_.size() == kFamilySize[int(ModelFamily::CellCounts)])
@@ -49,17 +51,27 @@ class CountCoder {
   template <class Coder>
   uint32_t code(Coder& coder, uint32_t population, int level, bool parentOneSided,
                 uint32_t firstHalf, int geometryClass = 0) {
-    BitModel* models =
-        geometryClass > 0 && population <= kExactPopulations
-            ? &geometryModels_[size_t(geometryClass) * kSmallNodes + populationOffset(population)]
-            : &models_[(size_t(level) * kParentClasses + parentOneSided) * kContextsPerLevel +
-                       populationOffset(population)];
+    BitModel* models = &models_[(size_t(level) * kParentClasses + parentOneSided) * kContextsPerLevel +
+                                populationOffset(population)];
+    // With a neighbourhood class, each decision mixes the class's model with
+    // the level's.
+    BitModel* geometric = geometryClass > 0 && population <= kExactPopulations
+                              ? &geometryModels_[size_t(geometryClass) * kSmallNodes + populationOffset(population)]
+                              : nullptr;
     uint32_t low = 0, candidates = population + 1, node = 1;
     while (candidates > 1) {
       if (node >= kTreeNodes)
         return low + coder.uniform(firstHalf - low, candidates);
       const uint32_t lowerHalf = candidates >> 1;
-      const bool upper = coder.bit(models[node], firstHalf - low >= lowerHalf);
+      bool upper = firstHalf - low >= lowerHalf;
+      if (geometric) {
+        upper = coder.bitWithProbability(mixer_.mix(geometryClass, {&geometric[node], &models[node]}), upper);
+        geometric[node].update(upper);
+        models[node].update(upper);
+        mixer_.update(upper);
+      } else {
+        upper = coder.bit(models[node], upper);
+      }
       if (upper) {
         low += lowerHalf;
         candidates -= lowerHalf;
@@ -95,6 +107,7 @@ class CountCoder {
 
   int levels_;
   std::vector<BitModel> models_, geometryModels_;
+  Mixer<2> mixer_;
 };
 
 }  // namespace kdmesh
