@@ -29,6 +29,7 @@
 #include <vector>
 
 #include "kdmesh/kdmesh.h"
+#include "mixer.h"
 #include "model_priors.h"
 #include "position_predictor.h"
 #include "range_coder.h"
@@ -98,7 +99,8 @@ class VertexSplitter {
   void classifyEdges(uint32_t v, int level);
   void linkFans();
   template <class Coder>
-  uint8_t codeSymbol(Coder& coder, BitModel (&models)[3], uint8_t possible, uint8_t code);
+  uint8_t codeSymbol(Coder& coder, BitModel (&models)[3], uint8_t possible, uint8_t code,
+                     BitModel* mixedWith = nullptr, int mixerSet = 0);
   template <class Coder>
   void decideOrientation(Coder& coder, int dimension, uint32_t simplex, bool isCopy, uint8_t target);
   int predictFlip(int dimension, uint32_t simplex, int& voteClass);
@@ -120,18 +122,33 @@ class VertexSplitter {
   // Edges: [cut edges so far][fan codes][class][all four codes possible]
   // (an edge's only face is the vertex, coded 3 or 4, so it has two sets).
   BitModel edgeModels_[3][8][kEdgeClasses][2][3];
+  // Edges by direction class alone, mixed with the above (weights per count
+  // of cut edges so far).
+  BitModel edgeDirectionModels_[kEdgeClasses][2][3];
+  Mixer<2> edgeMixer_{3, {45875, 19661}};
   // Orientation models: [dimension - 2][copy or new][vote class][face of higher].
   BitModel orientationModels_[2][2][3][2];
   ConnectivityStatistics statistics_;
 };
 
+// `mixedWith`: a second row of models, mixed with the first.
 template <class Coder>
-uint8_t VertexSplitter::codeSymbol(Coder& coder, BitModel (&models)[3], uint8_t possible, uint8_t code) {
+uint8_t VertexSplitter::codeSymbol(Coder& coder, BitModel (&models)[3], uint8_t possible, uint8_t code,
+                                   BitModel* mixedWith, int mixerSet) {
   int step = 0;
   for (uint8_t c = 1; c <= 4; ++c) {
     if (!(possible & (1u << (c - 1)))) continue;
     if ((possible >> c) == 0) return c;  // the last candidate left
-    if (coder.bit(models[step], c == code)) return c;
+    bool bit = c == code;
+    if (mixedWith) {
+      bit = coder.bitWithProbability(edgeMixer_.mix(mixerSet, {&models[step], &mixedWith[step]}), bit);
+      models[step].update(bit);
+      mixedWith[step].update(bit);
+      edgeMixer_.update(bit);
+    } else {
+      bit = coder.bit(models[step], bit);
+    }
+    if (bit) return c;
     ++step;
   }
   return 0;  // unreachable: `possible` is never empty here
@@ -168,12 +185,14 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, Ora
     entry.record = oracle();
     const uint8_t possible = possibleCodes(entry);
     if (possible == 0) return false;
-    entry.code = codeSymbol(
-        coder,
-        entry.dimension == 1
-            ? edgeModels_[std::min(cutEdges, 2)][entry.fanCodes][entry.geometry][possible == 0b1111]
-            : codeModels_[entry.dimension][possible],
-        possible, uint8_t((entry.record & split_record::kCodeMask) + 1));
+    const uint8_t code = uint8_t((entry.record & split_record::kCodeMask) + 1);
+    if (entry.dimension == 1) {
+      const bool all = possible == 0b1111;
+      entry.code = codeSymbol(coder, edgeModels_[std::min(cutEdges, 2)][entry.fanCodes][entry.geometry][all],
+                              possible, code, edgeDirectionModels_[entry.geometry][all], std::min(cutEdges, 2));
+    } else {
+      entry.code = codeSymbol(coder, codeModels_[entry.dimension][possible], possible, code);
+    }
     codedThree |= entry.code == 3;
     if (entry.dimension == 1) {
       cutEdges += entry.code == 4;
