@@ -65,10 +65,7 @@ class CountCoder {
       const uint32_t lowerHalf = candidates >> 1;
       bool upper = firstHalf - low >= lowerHalf;
       if (geometric) {
-        upper = coder.bitWithProbability(mixer_.mix(geometryClass, {&geometric[node], &models[node]}), upper);
-        geometric[node].update(upper);
-        models[node].update(upper);
-        mixer_.update(upper);
+        upper = mixer_.code(coder, geometryClass, {&geometric[node], &models[node]}, upper);
       } else {
         upper = coder.bit(models[node], upper);
       }

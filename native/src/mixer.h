@@ -67,6 +67,18 @@ class Mixer {
     return p0 < 64 ? 64 : p0 > kProbabilityOne - 64 ? kProbabilityOne - 64 : p0;
   }
 
+  // Codes `bit` (encoder; the decoder returns the decoded bit) with the mix
+  // of `inputs`, then updates the inputs and the weights.
+  template <class Coder>
+  bool code(Coder& coder, int set, const std::array<BitModel*, kInputs>& inputs, bool bit) {
+    std::array<const BitModel*, kInputs> read;
+    for (int i = 0; i < kInputs; ++i) read[size_t(i)] = inputs[size_t(i)];
+    bit = coder.bitWithProbability(mix(set, read), bit);
+    for (BitModel* model : inputs) model->update(bit);
+    update(bit);
+    return bit;
+  }
+
   void update(bool bit) {
     // A small rate: the inputs are adaptive models already, the weights
     // only settle how far to trust each (rates 2^-9 and faster measured worse).

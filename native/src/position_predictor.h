@@ -78,15 +78,10 @@ class PositionPredictor {
     if (!contextsOf(vertex, level, c)) {
       first = counts.codeSingle(coder, level, parentOneSided, inFirstHalf);
     } else {
-      BitModel& joint = models_[size_t(c.joint)];
-      BitModel& plane = planeModels_[size_t(c.plane)];
-      BitModel& centroid = centroidModels_[size_t(c.centroid)];
-      const uint32_t p0 = mixer_.mix(c.mixerSet, {&joint, &plane, &centroid});
-      const bool bit = coder.bitWithProbability(p0, inFirstHalf != c.mirrored);
-      joint.update(bit);
-      plane.update(bit);
-      centroid.update(bit);
-      mixer_.update(bit);
+      const bool bit = mixer_.code(coder, c.mixerSet,
+                                   {&models_[size_t(c.joint)], &planeModels_[size_t(c.plane)],
+                                    &centroidModels_[size_t(c.centroid)]},
+                                   inFirstHalf != c.mirrored);
       first = bit != c.mirrored;
     }
     Place& p = places_[vertex];

@@ -141,10 +141,7 @@ uint8_t VertexSplitter::codeSymbol(Coder& coder, BitModel (&models)[3], uint8_t 
     if ((possible >> c) == 0) return c;  // the last candidate left
     bool bit = c == code;
     if (mixedWith) {
-      bit = coder.bitWithProbability(edgeMixer_.mix(mixerSet, {&models[step], &mixedWith[step]}), bit);
-      models[step].update(bit);
-      mixedWith[step].update(bit);
-      edgeMixer_.update(bit);
+      bit = edgeMixer_.code(coder, mixerSet, {&models[step], &mixedWith[step]}, bit);
     } else {
       bit = coder.bit(models[step], bit);
     }
