@@ -139,6 +139,18 @@ void VertexSplitter::linkFans() {
   }
 }
 
+// A triangle v a b by the directions of a and b (classifyEdges): on the
+// same side of the split plane or not, and how close each is to it.
+int VertexSplitter::triangleClass(const Entry& triangle) const {
+  const Entry* a = findFace(1, &triangle.others[0]);
+  const Entry* b = findFace(1, &triangle.others[1]);
+  const double ca = cosines_[size_t(a - star_.data()) - begin_[1]];
+  const double cb = cosines_[size_t(b - star_.data()) - begin_[1]];
+  auto bucket = [](double c) { return std::fabs(c) < 0.2 ? 0 : std::fabs(c) < 0.45 ? 1 : 2; };
+  const int low = std::min(bucket(ca), bucket(cb)), high = std::max(bucket(ca), bucket(cb));
+  return ((ca > 0) == (cb > 0)) * 9 + low * 3 + high;
+}
+
 // After a split, the simplices around v and v2 are exactly the star's
 // simplices and their copies and additions: the neighbours that orient the
 // new ones are found there without walking the vertex lists.

@@ -98,6 +98,7 @@ class VertexSplitter {
   const Entry* findFace(int dimension, const uint32_t* others) const;
   void classifyEdges(uint32_t v, int level);
   void linkFans();
+  int triangleClass(const Entry& triangle) const;
   template <class Coder>
   uint8_t codeSymbol(Coder& coder, BitModel (&models)[3], uint8_t possible, uint8_t code,
                      BitModel* mixedWith = nullptr, int mixerSet = 0);
@@ -119,6 +120,11 @@ class VertexSplitter {
   // Code models: [dimension][possible set][step of the sequential binarisation].
   static constexpr int kEdgeClasses = 25;
   BitModel codeModels_[4][16][3];
+  // Triangles at geometric levels: [class of their two other vertices'
+  // directions][possible set][step] (what separates a tetrahedral mesh's
+  // star in two).
+  static constexpr int kTriangleClasses = 18;
+  BitModel triangleModels_[kTriangleClasses][16][3];
   // Edges: [cut edges so far][fan codes][class][all four codes possible]
   // (an edge's only face is the vertex, coded 3 or 4, so it has two sets).
   BitModel edgeModels_[3][8][kEdgeClasses][2][3];
@@ -175,6 +181,7 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, Ora
   gatherStar(store_, v, star_, begin_);
   linkFans();
   classifyEdges(v, level);
+  const bool geometric = geometry_.geometric(level);
   ++statistics_.vertexSplits;
   int cutEdges = 0;  // edges coded 4 so far: an edge expansion has two
   bool codedThree = false;
@@ -187,6 +194,8 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, Ora
       const bool all = possible == 0b1111;
       entry.code = codeSymbol(coder, edgeModels_[std::min(cutEdges, 2)][entry.fanCodes][entry.geometry][all],
                               possible, code, edgeDirectionModels_[entry.geometry][all], std::min(cutEdges, 2));
+    } else if (entry.dimension == 2 && geometric) {
+      entry.code = codeSymbol(coder, triangleModels_[triangleClass(entry)][possible], possible, code);
     } else {
       entry.code = codeSymbol(coder, codeModels_[entry.dimension][possible], possible, code);
     }
