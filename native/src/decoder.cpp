@@ -133,13 +133,13 @@ struct Decoder::State {
         return Status::error(ErrorCode::CorruptChunk,
                              where + ": more splits than the kd-tree has cells");
       if (cursor < cells.size()) {
-        if (connectivity && cursor == 0 && level < schedule->levels) predictor->snapshotNeighbours(store);
+        if (connectivity && cursor == 0 && level < schedule->levels) predictor->snapshotNeighbours(store, splitter->statistics().vertexSplits);
         if (!splitCell(cells[cursor++]))
           return Status::error(ErrorCode::CorruptChunk, where + ": inconsistent connectivity codes");
         --left;
       } else {
         const size_t count = std::min<size_t>(left, singleLevelEnd - singleCursor);
-        if (connectivity && singleCursor == 0 && count > 0) predictor->snapshotNeighbours(store);
+        if (connectivity && singleCursor == 0 && count > 0) predictor->snapshotNeighbours(store, splitter->statistics().vertexSplits);
         refineSingles(singleCursor, singleCursor + count);
         singleCursor += count;
         left -= uint32_t(count);

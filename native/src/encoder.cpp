@@ -313,10 +313,10 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
       if (connectivity) predictor.place(id, prefix, level);
     }
     void cellsBegin() {
-      if (connectivity) predictor.snapshotNeighbours(forward);
+      if (connectivity) predictor.snapshotNeighbours(forward, splitter.statistics().vertexSplits);
     }
     void singlesBegin() {
-      if (connectivity) predictor.snapshotNeighbours(forward);
+      if (connectivity) predictor.snapshotNeighbours(forward, splitter.statistics().vertexSplits);
     }
     void single(int level, bool parentOneSided, bool inFirstHalf, uint32_t id) {
       double b0 = coder.cost();

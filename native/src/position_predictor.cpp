@@ -61,7 +61,9 @@ void PositionPredictor::centre(const Place& place, double out[3]) const {
   for (int a = 0; a < 3; ++a) out[a] = double(place.prefix[a]) * width[size_t(a)] + (width[size_t(a)] - 1) * 0.5;
 }
 
-void PositionPredictor::snapshotNeighbours(const SimplexStore& store) {
+void PositionPredictor::snapshotNeighbours(const SimplexStore& store, uint64_t splits) {
+  if (splits == snapshotSplits_ && firstNeighbour_.size() == places_.size() + 1) return;
+  snapshotSplits_ = splits;
   const uint32_t vertexCount = uint32_t(places_.size());
   firstNeighbour_.assign(size_t(vertexCount) + 1, 0);
   const uint32_t edges = store.size(1);

@@ -57,7 +57,9 @@ class PositionPredictor {
   // geometric level start splitting (their counts are then predicted from
   // the complex as it was at the start of the level) and again when its
   // one-vertex cells do (the complex does not change while they split).
-  void snapshotNeighbours(const SimplexStore& store);
+  // `splits` counts the vertex splits so far: the same count as at the last
+  // snapshot means the same complex, and the lists are kept.
+  void snapshotNeighbours(const SimplexStore& store, uint64_t splits);
 
   // Geometry class (0..kCountClasses-1) of the split of a cell of several
   // vertices at `level` whose vertex in the complex is `vertex`: how close
@@ -181,6 +183,7 @@ class PositionPredictor {
   // proceed in parallel, where the store's linked incidence lists would
   // chain them.
   std::vector<uint32_t> firstNeighbour_, neighbours_;
+  uint64_t snapshotSplits_ = ~uint64_t(0);
   std::vector<BitModel> models_, planeModels_, centroidModels_;
   Mixer<3> mixer_;
   mutable uint64_t countPredictions_ = 0;
