@@ -344,6 +344,12 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
     finalModels->families[int(ModelFamily::CellCounts)] = counts.geometryModels();
     finalModels->families[int(ModelFamily::OneVertexByPlane)] = predictor.planeModels();
     finalModels->families[int(ModelFamily::OneVertexByCentroid)] = predictor.centroidModels();
+    const BitModel* byDirection = splitter.edgeDirectionModels();
+    finalModels->families[int(ModelFamily::EdgeCodesByDirection)].assign(
+        byDirection, byDirection + kFamilySize[int(ModelFamily::EdgeCodesByDirection)]);
+    const BitModel* triangles = splitter.triangleModels();
+    finalModels->families[int(ModelFamily::TriangleCodes)].assign(
+        triangles, triangles + kFamilySize[int(ModelFamily::TriangleCodes)]);
   }
   predictor.addStatistics(result.statistics);
   report("code", 1);

@@ -18,9 +18,17 @@
 
 namespace kdmesh {
 
-enum class ModelFamily { OneVertexSplits, EdgeCodes, CellCounts, OneVertexByPlane, OneVertexByCentroid };
-constexpr int kModelFamilies = 5;
-constexpr std::array<size_t, kModelFamilies> kFamilySize = {1500, 3600, 1530, 150, 50};
+enum class ModelFamily {
+  OneVertexSplits,
+  EdgeCodes,
+  CellCounts,
+  OneVertexByPlane,
+  OneVertexByCentroid,
+  EdgeCodesByDirection,
+  TriangleCodes,
+};
+constexpr int kModelFamilies = 7;
+constexpr std::array<size_t, kModelFamilies> kFamilySize = {1500, 3600, 1530, 150, 50, 150, 864};
 
 // As many observations as a prior is worth: the slow estimator then starts
 // at a moderate rate and still follows the model at hand.

@@ -76,6 +76,11 @@ class VertexSplitter {
       : store_(store), geometry_(geometry) {
     static_assert(sizeof(edgeModels_) / sizeof(BitModel) == kFamilySize[int(ModelFamily::EdgeCodes)]);
     primeModels(ModelFamily::EdgeCodes, edgeModels());
+    static_assert(sizeof(edgeDirectionModels_) / sizeof(BitModel) ==
+                  kFamilySize[int(ModelFamily::EdgeCodesByDirection)]);
+    primeModels(ModelFamily::EdgeCodesByDirection, edgeDirectionModels());
+    static_assert(sizeof(triangleModels_) / sizeof(BitModel) == kFamilySize[int(ModelFamily::TriangleCodes)]);
+    primeModels(ModelFamily::TriangleCodes, triangleModels());
   }
 
   // Splits `v`, whose cell is at `level`, into `v` and `v2`. `next()` of the
@@ -87,6 +92,8 @@ class VertexSplitter {
 
   const ConnectivityStatistics& statistics() const { return statistics_; }
   BitModel* edgeModels() { return &edgeModels_[0][0][0][0][0]; }
+  BitModel* edgeDirectionModels() { return &edgeDirectionModels_[0][0][0]; }
+  BitModel* triangleModels() { return &triangleModels_[0][0][0]; }
 
  private:
   using Entry = StarEntry;

@@ -18,7 +18,8 @@ namespace {
 constexpr double kMaxWeight = 256;
 constexpr const char* kNames[kdmesh::kModelFamilies] = {"kOneVertexSplitPriors", "kEdgeCodePriors",
                                                          "kCellCountPriors", "kOneVertexByPlanePriors",
-                                                         "kOneVertexByCentroidPriors"};
+                                                         "kOneVertexByCentroidPriors", "kEdgeCodeByDirectionPriors",
+                                                         "kTriangleCodePriors"};
 
 }  // namespace
 
