@@ -7,9 +7,9 @@
 //   - the kd-tree level (cell size relative to the sampling density),
 //   - whether the parent split sent all its vertices to one side, and
 //   - the node of the bisection tree (the decisions taken so far),
-//   - and, for populations up to 15 in a complex, a geometry class from the
-//     cell's neighbourhood (PositionPredictor::countContext), in place of
-//     the level and the parent's split.
+//   - and, for populations up to 15 in a complex, a class of the cell's
+//     neighbourhood (PositionPredictor::countContext), whose model is mixed
+//     with the one above.
 // After six decisions the few remaining candidates of a large cell are nearly
 // equiprobable and are coded uniformly.
 #pragma once
@@ -23,18 +23,32 @@
 
 namespace kdmesh {
 
+// What the neighbourhood of a cell says about its split
+// (PositionPredictor::countContext): a class 1..kNeighbourhoodClasses-1 (0:
+// nothing), and whether the prediction favours the first half, in which case
+// the count of the second half is coded instead (mirroring).
+struct CountContext {
+  int neighbourhoodClass = 0;
+  bool mirrored = false;
+};
+
 class CountCoder {
  public:
-  // `geometryClasses`: how many classes code() may be given (0 for none).
-  CountCoder(int levels, int geometryClasses)
-      : levels_(levels < 1 ? 1 : levels), mixer_(geometryClasses < 1 ? 1 : geometryClasses, {45875, 19661}) {
+  static constexpr int kNeighbourhoodClasses = 9;
+
+  // `neighbourhoods`: code() may be given neighbourhood classes (streams
+  // with connectivity).
+  CountCoder(int levels, bool neighbourhoods)
+      : levels_(levels < 1 ? 1 : levels), mixer_(kNeighbourhoodClasses, {45875, 19661}) {
     models_.resize(size_t(levels_) * kParentClasses * kContextsPerLevel);
-    geometryModels_.resize(size_t(geometryClasses) * kSmallNodes);
-    if (geometryModels_.size() == kFamilySize[int(ModelFamily::CellCounts)])
-      primeModels(ModelFamily::CellCounts, geometryModels_.data());
+    static_assert(size_t(kNeighbourhoodClasses) * kSmallNodes == kFamilySize[int(ModelFamily::CellCounts)]);
+    if (neighbourhoods) {
+      neighbourhoodModels_.resize(kFamilySize[int(ModelFamily::CellCounts)]);
+      primeModels(ModelFamily::CellCounts, neighbourhoodModels_.data());
+    }
   }
 
-  const std::vector<BitModel>& geometryModels() const { return geometryModels_; }
+  const std::vector<BitModel>& neighbourhoodModels() const { return neighbourhoodModels_; }
 
   // The count of a one-vertex cell, 1 when the vertex is in the first half;
   // the same model as code() with population 1, in a loop-free form.
@@ -45,30 +59,39 @@ class CountCoder {
                      inFirstHalf);
   }
 
-  // `parentOneSided`: the parent cell's split left one half empty;
-  // `geometryClass` 1.. a class from the neighbourhood, 0 without one.
+  // `parentOneSided`: the parent cell's split left one half empty.
   // On the encoder returns `firstHalf`; on the decoder returns the decoded count.
   template <class Coder>
   uint32_t code(Coder& coder, uint32_t population, int level, bool parentOneSided,
-                uint32_t firstHalf, int geometryClass = 0) {
+                uint32_t firstHalf, const CountContext& context = {}) {
+    const uint32_t coded = codeOrdered(coder, population, level, parentOneSided,
+                                       context.mirrored ? population - firstHalf : firstHalf,
+                                       context.neighbourhoodClass);
+    return context.mirrored ? population - coded : coded;
+  }
+
+ private:
+  template <class Coder>
+  uint32_t codeOrdered(Coder& coder, uint32_t population, int level, bool parentOneSided,
+                       uint32_t firstHalf, int neighbourhoodClass) {
     BitModel* models = &models_[(size_t(level) * kParentClasses + parentOneSided) * kContextsPerLevel +
                                 populationOffset(population)];
     // With a neighbourhood class, each decision mixes the class's model with
     // the level's.
-    BitModel* geometric = geometryClass > 0 && population <= kExactPopulations
-                              ? &geometryModels_[size_t(geometryClass) * kSmallNodes + populationOffset(population)]
-                              : nullptr;
+    BitModel* byNeighbourhood =
+        neighbourhoodClass > 0 && population <= kExactPopulations
+            ? &neighbourhoodModels_[size_t(neighbourhoodClass) * kSmallNodes + populationOffset(population)]
+            : nullptr;
     uint32_t low = 0, candidates = population + 1, node = 1;
     while (candidates > 1) {
       if (node >= kTreeNodes)
         return low + coder.uniform(firstHalf - low, candidates);
       const uint32_t lowerHalf = candidates >> 1;
       bool upper = firstHalf - low >= lowerHalf;
-      if (geometric) {
-        upper = mixer_.code(coder, geometryClass, {&geometric[node], &models[node]}, upper);
-      } else {
+      if (byNeighbourhood)
+        upper = mixer_.code(coder, neighbourhoodClass, {&byNeighbourhood[node], &models[node]}, upper);
+      else
         upper = coder.bit(models[node], upper);
-      }
       if (upper) {
         low += lowerHalf;
         candidates -= lowerHalf;
@@ -80,7 +103,6 @@ class CountCoder {
     return low;
   }
 
- private:
   static constexpr uint32_t kExactPopulations = 15;  // p = 1..15 get own models
   static constexpr uint32_t kTreeNodes = 64;         // six bisection levels
   static constexpr uint32_t kParentClasses = 2;
@@ -103,7 +125,7 @@ class CountCoder {
   }
 
   int levels_;
-  std::vector<BitModel> models_, geometryModels_;
+  std::vector<BitModel> models_, neighbourhoodModels_;
   Mixer<2> mixer_;
 };
 

@@ -96,7 +96,7 @@ struct Decoder::State {
     schedule.emplace(header);
     dequantizer.emplace(header);
     connectivity = header.maxDimension > 0;
-    counts.emplace(schedule->levels, connectivity ? PositionPredictor::kCountClasses : 0);
+    counts.emplace(schedule->levels, connectivity);
     coder.setMeasuring(options.measureCost);
     const Cell root{{0, 0, 0}, header.vertexCount, 0, 0, 0};
     (header.vertexCount == 1 ? singles : cells).push_back(root);
@@ -133,13 +133,13 @@ struct Decoder::State {
         return Status::error(ErrorCode::CorruptChunk,
                              where + ": more splits than the kd-tree has cells");
       if (cursor < cells.size()) {
-        if (connectivity && cursor == 0 && level < schedule->levels) predictor->snapshotNeighbours(store, splitter->statistics().vertexSplits);
+        if (connectivity && cursor == 0 && level < schedule->levels) snapshotNeighbours();
         if (!splitCell(cells[cursor++]))
           return Status::error(ErrorCode::CorruptChunk, where + ": inconsistent connectivity codes");
         --left;
       } else {
         const size_t count = std::min<size_t>(left, singleLevelEnd - singleCursor);
-        if (connectivity && singleCursor == 0 && count > 0) predictor->snapshotNeighbours(store, splitter->statistics().vertexSplits);
+        if (connectivity && singleCursor == 0 && count > 0) snapshotNeighbours();
         refineSingles(singleCursor, singleCursor + count);
         singleCursor += count;
         left -= uint32_t(count);
@@ -169,17 +169,16 @@ struct Decoder::State {
     return Status::success();
   }
 
+  void snapshotNeighbours() { predictor->snapshotNeighbours(store, splitter->statistics().vertexSplits); }
+
   // Returns false on connectivity codes that contradict each other.
   bool splitCell(const Cell& cell) {
     const uint32_t population = cell.population;
     const bool geometric = level < schedule->levels;
-    uint32_t firstHalf = population / 2;
-    if (geometric) {
-      bool mirrored = false;
-      const int geometryClass = connectivity ? predictor->countContext(cell.vertex, level, mirrored) : 0;
-      firstHalf = counts->code(coder, population, level, cell.parentOneSided, 0, geometryClass);
-      if (mirrored) firstHalf = population - firstHalf;
-    }
+    const uint32_t firstHalf =
+        geometric ? counts->code(coder, population, level, cell.parentOneSided, 0,
+                                 connectivity ? predictor->countContext(cell.vertex, level) : CountContext{})
+                  : population / 2;
     const bool oneSided = firstHalf == 0 || firstHalf == population;
     Cell child = cell;
     child.parentOneSided = oneSided;

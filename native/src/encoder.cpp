@@ -18,9 +18,7 @@
 #include "split_schedule.h"
 #include "vertex_split.h"
 
-#include <cstdio>
 namespace kdmesh {
-double multiBits[200], singleBits[200]; long singleN[200];
 namespace {
 
 constexpr size_t kFirstChunkBytes = 1024;
@@ -112,11 +110,11 @@ class ChunkWriter {
 // The visitor sees cell(level, geometric, population, firstHalf,
 // parentOneSided, keptId, addedId) for cells of several vertices (addedId is
 // kNoSimplex for a one-sided split), placed(id, prefix, level) for each
-// non-empty half of a geometric split, cellsBegin() and singlesBegin()
-// before the cells of several vertices and of one vertex of a geometric
-// level, single(level, parentOneSided,
-// inFirstHalf, id) for one-vertex cells, named(keyIndex, id) when a vertex
-// gets its final id, and splitDone() after each split.
+// non-empty half of a geometric split, snapshot() before the cells of
+// several vertices and again before those of one vertex of a geometric
+// level, single(level, parentOneSided, inFirstHalf, id) for one-vertex
+// cells, named(keyIndex, id) when a vertex gets its final id, and
+// splitDone() after each split.
 template <class Visitor>
 void traverseKdTree(const std::vector<KdKey>& keys, const SplitSchedule& schedule,
                     bool coincidentLevels, Visitor&& visitor) {
@@ -148,7 +146,7 @@ void traverseKdTree(const std::vector<KdKey>& keys, const SplitSchedule& schedul
     const size_t oldSingles = singles.size();
     const size_t singleLevelEnd = geometric ? oldSingles : 0;
     children.clear();
-    if (geometric && !cells.empty()) visitor.cellsBegin();
+    if (geometric && !cells.empty()) visitor.snapshot();
     for (const Cell& cell : cells) {
       const uint32_t population = cell.end - cell.begin;
       const uint32_t split =
@@ -180,7 +178,7 @@ void traverseKdTree(const std::vector<KdKey>& keys, const SplitSchedule& schedul
       }
       visitor.splitDone();
     }
-    if (singleLevelEnd > 0) visitor.singlesBegin();
+    if (singleLevelEnd > 0) visitor.snapshot();
     for (size_t i = 0; i < singleLevelEnd; ++i) {
       Single& single = singles[i];
       visitor.single(level, single.parentOneSided, ((keys[single.key] >> bit) & 1) == 0, single.id);
@@ -241,8 +239,7 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
         if (added != kNoSimplex) splits.push_back({kept, added});
       }
       void placed(uint32_t, const uint32_t*, int) {}
-      void cellsBegin() {}
-      void singlesBegin() {}
+      void snapshot() {}
       void single(int, bool, bool, uint32_t) {}
       void named(uint32_t key, uint32_t id) { ids[vertexOfKey[key]] = id; }
       void splitDone() {}
@@ -265,7 +262,7 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
   std::vector<uint8_t> body;
   ChunkWriter chunks(body, options.chunkBytes);
   RangeEncoder& coder = chunks.coder();
-  CountCoder counts(schedule.levels, connectivity ? PositionPredictor::kCountClasses : 0);
+  CountCoder counts(schedule.levels, connectivity);
   SimplexStore forward;
   forward.reset(header.vertexCount, false);
   PositionPredictor predictor(schedule);
@@ -294,14 +291,9 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
         reportedLevel = level;
         report("code", double(level) / double(schedule.levels + 1));
       }
-      { double b0 = coder.cost();
-      if (geometric) {
-        bool mirrored = false;
-        const int geometryClass = connectivity ? predictor.countContext(kept, level, mirrored) : 0;
-        counts.code(coder, population, level, parentOneSided, mirrored ? population - firstHalf : firstHalf,
-                    geometryClass);
-      }
-      multiBits[level] += coder.cost() - b0; }
+      if (geometric)
+        counts.code(coder, population, level, parentOneSided, firstHalf,
+                    connectivity ? predictor.countContext(kept, level) : CountContext{});
       if (connectivity && added != kNoSimplex) {
         const double before = coder.cost();
         splitter.split(coder, kept, added, level, RecordReader{&records.bytes[records.begin[splitIndex]]});
@@ -312,15 +304,10 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
     void placed(uint32_t id, const uint32_t* prefix, int level) {
       if (connectivity) predictor.place(id, prefix, level);
     }
-    void cellsBegin() {
-      if (connectivity) predictor.snapshotNeighbours(forward, splitter.statistics().vertexSplits);
-    }
-    void singlesBegin() {
+    void snapshot() {
       if (connectivity) predictor.snapshotNeighbours(forward, splitter.statistics().vertexSplits);
     }
     void single(int level, bool parentOneSided, bool inFirstHalf, uint32_t id) {
-      double b0 = coder.cost();
-      struct G { double b0; RangeEncoder& c; int l; ~G(){ singleBits[l] += c.cost()-b0; singleN[l]++; } } g{b0, coder, level};
       if (connectivity)
         predictor.codeSingle(coder, counts, id, level, parentOneSided, inFirstHalf);
       else
@@ -337,23 +324,20 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
   result.cost.geometryBits = coder.cost() - connectivityBits;
   result.statistics = splitter.statistics();
   if (finalModels && connectivity) {
-    finalModels->families[int(ModelFamily::OneVertexSplits)] = predictor.models();
-    const BitModel* edges = splitter.edgeModels();
-    finalModels->families[int(ModelFamily::EdgeCodes)].assign(
-        edges, edges + kFamilySize[int(ModelFamily::EdgeCodes)]);
-    finalModels->families[int(ModelFamily::CellCounts)] = counts.geometryModels();
-    finalModels->families[int(ModelFamily::OneVertexByPlane)] = predictor.planeModels();
-    finalModels->families[int(ModelFamily::OneVertexByCentroid)] = predictor.centroidModels();
-    const BitModel* byDirection = splitter.edgeDirectionModels();
-    finalModels->families[int(ModelFamily::EdgeCodesByDirection)].assign(
-        byDirection, byDirection + kFamilySize[int(ModelFamily::EdgeCodesByDirection)]);
-    const BitModel* triangles = splitter.triangleModels();
-    finalModels->families[int(ModelFamily::TriangleCodes)].assign(
-        triangles, triangles + kFamilySize[int(ModelFamily::TriangleCodes)]);
+    auto keep = [&](ModelFamily family, const BitModel* models) {
+      finalModels->families[int(family)].assign(models, models + kFamilySize[int(family)]);
+    };
+    keep(ModelFamily::OneVertexSplits, predictor.models().data());
+    keep(ModelFamily::OneVertexByPlane, predictor.planeModels().data());
+    keep(ModelFamily::OneVertexByCentroid, predictor.centroidModels().data());
+    keep(ModelFamily::CellCounts, counts.neighbourhoodModels().data());
+    keep(ModelFamily::EdgeCodes, splitter.edgeModels());
+    keep(ModelFamily::EdgeCodesByDirection, splitter.edgeDirectionModels());
+    keep(ModelFamily::TriangleCodes, splitter.triangleModels());
   }
+
   predictor.addStatistics(result.statistics);
   report("code", 1);
-  if (getenv("KD_LEVELS")) { double m=0,sg=0; for (int l=0;l<schedule.levels;++l){ fprintf(stderr,"L%2d multi %9.0f single %9.0f n %8ld (%.3f)\n",l,multiBits[l],singleBits[l],singleN[l],singleN[l]?singleBits[l]/singleN[l]:0); m+=multiBits[l]; sg+=singleBits[l];} fprintf(stderr,"multi %.3f single %.3f bpv\n", m/header.vertexCount, sg/header.vertexCount);}
 
   result.bytes.resize(kHeaderBytes + body.size());
   writeHeader(header, result.bytes.data());

@@ -54,7 +54,7 @@ class Mixer {
   Mixer(int sets, const std::array<int32_t, kInputs>& initial) : weights_(size_t(sets), initial) {}
 
   // P(bit == 0) in units of 2^-15 for the coder.
-  uint32_t mix(int set, const std::array<const BitModel*, kInputs>& inputs) {
+  uint32_t mix(int set, const std::array<BitModel*, kInputs>& inputs) {
     set_ = set;
     int64_t dot = 0;
     for (int i = 0; i < kInputs; ++i) {
@@ -71,9 +71,7 @@ class Mixer {
   // of `inputs`, then updates the inputs and the weights.
   template <class Coder>
   bool code(Coder& coder, int set, const std::array<BitModel*, kInputs>& inputs, bool bit) {
-    std::array<const BitModel*, kInputs> read;
-    for (int i = 0; i < kInputs; ++i) read[size_t(i)] = inputs[size_t(i)];
-    bit = coder.bitWithProbability(mix(set, read), bit);
+    bit = coder.bitWithProbability(mix(set, inputs), bit);
     for (BitModel* model : inputs) model->update(bit);
     update(bit);
     return bit;

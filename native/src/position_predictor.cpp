@@ -62,7 +62,7 @@ void PositionPredictor::centre(const Place& place, double out[3]) const {
 }
 
 void PositionPredictor::snapshotNeighbours(const SimplexStore& store, uint64_t splits) {
-  if (splits == snapshotSplits_ && firstNeighbour_.size() == places_.size() + 1) return;
+  if (splits == snapshotSplits_) return;
   snapshotSplits_ = splits;
   const uint32_t vertexCount = uint32_t(places_.size());
   firstNeighbour_.assign(size_t(vertexCount) + 1, 0);
@@ -97,12 +97,14 @@ PositionPredictor::Features PositionPredictor::features(const Neighbourhood& aro
   const double* normal = around.normal;
   const double along = std::fabs(normal[axis]) * halfWidth[axis];
   if (along > 0) {
-    double across = 0, offset = 0;
+    // The plane n·(x − centroid) = 0 meets the split axis through the cell
+    // centre (the origin here) at x_axis = n·centroid / n_axis.
+    double across = 0, rise = 0;
     for (int a = 0; a < 3; ++a) {
-      offset -= normal[a] * centroid[a];
+      rise += normal[a] * centroid[a];
       if (a != axis) across += std::fabs(normal[a]) * halfWidth[a];
     }
-    f.planeOffset = -offset / (normal[axis] * halfWidth[axis]);
+    f.planeOffset = rise / (normal[axis] * halfWidth[axis]);
     f.tilt = across / along;
     f.hasPlane = true;
   }
@@ -142,20 +144,18 @@ bool PositionPredictor::contextsOf(uint32_t vertex, int level, SingleContexts& c
   return true;
 }
 
-int PositionPredictor::countContext(uint32_t vertex, int level, bool& mirrored) const {
+CountContext PositionPredictor::countContext(uint32_t vertex, int level) {
   Neighbourhood around;
-  mirrored = false;
-  if (!gather(vertex, around)) return 0;
+  if (!gather(vertex, around)) return {};
   ++countPredictions_;
   const Features f = features(around, level);
-  mirrored = f.mirrored;
   if (!f.hasPlane) {
     const double c = f.centroidOffset;
-    return c < 0.5 ? 6 : c < 1.5 ? 7 : 8;
+    return {c < 0.5 ? 6 : c < 1.5 ? 7 : 8, f.mirrored};
   }
   // How close the plane comes to the split plane inside the cell, in half widths.
   const double gap = f.planeOffset - f.tilt;
-  return gap <= 0 ? 1 : gap < 0.5 ? 2 : gap < 1 ? 3 : gap < 2 ? 4 : 5;
+  return {gap <= 0 ? 1 : gap < 0.5 ? 2 : gap < 1 ? 3 : gap < 2 ? 4 : 5, f.mirrored};
 }
 
 }  // namespace kdmesh

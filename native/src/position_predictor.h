@@ -1,16 +1,16 @@
-// Geometry from connectivity: the split of a one-vertex cell, coded with
-// the knowledge of the vertex's neighbours in the current complex.
+// Geometry from connectivity: where a vertex lies, predicted from its
+// neighbours in the current complex.
 //
 // A one-vertex cell's split decides one bit of its vertex's coordinate along
-// the split axis. Without connectivity that bit is close to a coin toss. With
-// it, the vertex's edges and triangles point at where it should be: near the
-// centroid of its neighbours (cells of the current level, taken at their
-// centres), and, on a surface, on the plane through that centroid whose
-// normal is the sum of the vertex's oriented triangle normals (the fan's
-// vector area, which does not depend on the vertex's own position).
+// the split axis; without connectivity that bit is close to a coin toss. The
+// vertex's neighbours (cells of the current level, taken at their centres)
+// say where it should be: near their centroid and, on a surface, on the
+// plane through that centroid whose normal sums the cross products of
+// consecutive neighbour offsets, each turned to agree with the sum so far
+// (the plane's orientation does not matter, so the neighbours need no order).
 //
-// Both predictions are turned into features measured in the cell's own half
-// width along the split axis, bucketed, and used to choose an adaptive model:
+// Both predictions become features measured in the cell's half width along
+// the split axis:
 //   - where the plane crosses the split axis, relative to the split plane;
 //   - how much the plane tilts across the cell (the other axes' share of the
 //     normal): a plane nearly parallel to the split says a lot, one across it
@@ -19,7 +19,9 @@
 //   - the neighbours' distance against the cell size (coarse cells are
 //     larger than the gaps between neighbours and predict little).
 // The configuration is mirrored so that the prediction points to the upper
-// half, which lets the two mirror images share statistics.
+// half, which lets the two mirror images share statistics. A one-vertex split
+// mixes three models chosen by these features (mixer.h); the split of a cell
+// of several vertices gets a class for CountCoder.
 #pragma once
 
 #include <algorithm>
@@ -57,17 +59,15 @@ class PositionPredictor {
   // geometric level start splitting (their counts are then predicted from
   // the complex as it was at the start of the level) and again when its
   // one-vertex cells do (the complex does not change while they split).
-  // `splits` counts the vertex splits so far: the same count as at the last
-  // snapshot means the same complex, and the lists are kept.
+  // `splits` counts the vertex splits so far: only splits change the
+  // complex, so the same count as at the last snapshot keeps the lists.
   void snapshotNeighbours(const SimplexStore& store, uint64_t splits);
 
-  // Geometry class (0..kCountClasses-1) of the split of a cell of several
-  // vertices at `level` whose vertex in the complex is `vertex`: how close
-  // its neighbourhood's plane comes to the split plane (1..5, or 6..8 from
-  // the centroid alone without a plane, 0 without neighbours). With
-  // `mirrored` the prediction favours the first half.
-  static constexpr int kCountClasses = 9;
-  int countContext(uint32_t vertex, int level, bool& mirrored) const;
+  // The neighbourhood class of the split of a cell of several vertices at
+  // `level` whose vertex in the complex is `vertex`: how close its
+  // neighbourhood's plane comes to the split plane (1..5, or 6..8 from the
+  // centroid alone without a plane, 0 without neighbours).
+  CountContext countContext(uint32_t vertex, int level);
 
   // Codes whether the vertex of a one-vertex cell at `level` lies in its
   // first half, and moves the vertex's cell to that half. A vertex without
@@ -95,19 +95,10 @@ class PositionPredictor {
 
   bool geometric(int level) const { return size_t(level) < axis_.size(); }
 
-  // For a cell split at a geometric `level`: the cosine of the angle between
-  // the split axis and the direction from v's cell centre to w's.
-  double axisCosine(uint32_t v, uint32_t w, int level) const {
-    double from[3], to[3];
-    centre(places_[v], from);
-    centre(places_[w], to);
-    double squared = 0;
-    for (int a = 0; a < 3; ++a) {
-      to[a] -= from[a];
-      squared += to[a] * to[a];
-    }
-    return squared > 0 ? to[axis_[size_t(level)]] / std::sqrt(squared) : 0;
-  }
+  // The split axis of a geometric `level`, and the centre of a vertex's
+  // current cell in grid units.
+  int axis(int level) const { return axis_[size_t(level)]; }
+  void centreOf(uint32_t vertex, double out[3]) const { centre(places_[vertex], out); }
 
   const std::vector<BitModel>& models() const { return models_; }
   const std::vector<BitModel>& planeModels() const { return planeModels_; }
@@ -138,9 +129,7 @@ class PositionPredictor {
         sum[a] += p[a];
         squaredDistance += p[a] * p[a];
       }
-      // The plane's orientation does not matter, so neighbours need no
-      // order: the normal sums the cross products of the offsets of
-      // consecutive neighbours, each turned to agree with the sum so far.
+      // The normal: see the top of this file.
       if (count > 0) {
         const double cross[3] = {previous[1] * p[2] - previous[2] * p[1], previous[2] * p[0] - previous[0] * p[2],
                                  previous[0] * p[1] - previous[1] * p[0]};
@@ -186,7 +175,7 @@ class PositionPredictor {
   uint64_t snapshotSplits_ = ~uint64_t(0);
   std::vector<BitModel> models_, planeModels_, centroidModels_;
   Mixer<3> mixer_;
-  mutable uint64_t countPredictions_ = 0;
+  uint64_t countPredictions_ = 0;
   uint64_t positionPredictions_ = 0;
 };
 

@@ -96,14 +96,25 @@ void VertexSplitter::classifyEdges(uint32_t v, int level) {
   }
   cosines_.resize(last - first);
   statistics_.edgeCodesByDirection += last - first;
-  for (size_t i = first; i < last; ++i) cosines_[i - first] = geometry_.axisCosine(v, star_[i].others[0], level);
+  const int axis = geometry_.axis(level);
+  double from[3];
+  geometry_.centreOf(v, from);
+  for (size_t i = first; i < last; ++i) {
+    double to[3], squared = 0;
+    geometry_.centreOf(star_[i].others[0], to);
+    for (int a = 0; a < 3; ++a) {
+      to[a] -= from[a];
+      squared += to[a] * to[a];
+    }
+    cosines_[i - first] = squared > 0 ? to[axis] / std::sqrt(squared) : 0;
+  }
   for (size_t i = first; i < last; ++i) {
     const double cosine = cosines_[i - first], magnitude = std::fabs(cosine);
     const int bucket = magnitude < 0.2 ? 0 : magnitude < 0.45 ? 1 : magnitude < 0.7 ? 2 : 3;
     // Between a fan neighbour on v's side and one on v2's side lies a cut
     // edge: likely the one of the two closer to the split plane.
     int crossing = 0;
-    for (const uint32_t neighbour : star_[i].fan) {
+    for (const uint32_t neighbour : star_[i].links) {
       if (neighbour == kNoSimplex) continue;
       const double theirs = cosines_[neighbour - first];
       if ((theirs > 0) == (cosine > 0)) continue;
@@ -119,33 +130,35 @@ void VertexSplitter::classifyEdges(uint32_t v, int level) {
 // already given to an edge's fan neighbours say much about its own. Two
 // neighbours per edge are kept (a manifold fan has no more).
 void VertexSplitter::linkFans() {
-  for (size_t i = begin_[1]; i < begin_[2]; ++i) {
+  for (size_t i = begin_[1]; i < begin_[3]; ++i) {
     star_[i].fanCodes = 0;
-    star_[i].fan[0] = star_[i].fan[1] = kNoSimplex;
+    star_[i].links[0] = star_[i].links[1] = kNoSimplex;
   }
-  auto link = [this](const Entry* from, size_t to) {
-    uint32_t* fan = const_cast<Entry*>(from)->fan;
-    if (fan[0] == kNoSimplex)
-      fan[0] = uint32_t(to);
-    else if (fan[1] == kNoSimplex)
-      fan[1] = uint32_t(to);
+  auto link = [this](uint32_t from, uint32_t to) {
+    uint32_t* links = star_[from].links;
+    if (links[0] == kNoSimplex)
+      links[0] = to;
+    else if (links[1] == kNoSimplex)
+      links[1] = to;
   };
   for (size_t i = begin_[2]; i < begin_[3]; ++i) {
     const Entry* first = findFace(1, &star_[i].others[0]);
     const Entry* second = findFace(1, &star_[i].others[1]);
     if (first == nullptr || second == nullptr) continue;
-    link(first, size_t(second - star_.data()));
-    link(second, size_t(first - star_.data()));
+    const uint32_t a = uint32_t(first - star_.data()), b = uint32_t(second - star_.data());
+    star_[i].links[0] = a;
+    star_[i].links[1] = b;
+    link(a, b);
+    link(b, a);
   }
 }
 
 // A triangle v a b by the directions of a and b (classifyEdges): on the
-// same side of the split plane or not, and how close each is to it.
+// same side of the split plane or not, and how close each is to it. Its
+// edges va and vb exist (possibleCodes checked), so linkFans linked them.
 int VertexSplitter::triangleClass(const Entry& triangle) const {
-  const Entry* a = findFace(1, &triangle.others[0]);
-  const Entry* b = findFace(1, &triangle.others[1]);
-  const double ca = cosines_[size_t(a - star_.data()) - begin_[1]];
-  const double cb = cosines_[size_t(b - star_.data()) - begin_[1]];
+  const double ca = cosines_[triangle.links[0] - begin_[1]];
+  const double cb = cosines_[triangle.links[1] - begin_[1]];
   auto bucket = [](double c) { return std::fabs(c) < 0.2 ? 0 : std::fabs(c) < 0.45 ? 1 : 2; };
   const int low = std::min(bucket(ca), bucket(cb)), high = std::max(bucket(ca), bucket(cb));
   return ((ca > 0) == (cb > 0)) * 9 + low * 3 + high;

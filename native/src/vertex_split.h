@@ -12,6 +12,10 @@
 // 1, a face coded 2 forces 2, a face coded 3 excludes 4, and the code of S
 // must allow its children's faces), so implied codes cost nothing; the rest
 // are coded with adaptive models per dimension and set of possible codes.
+// At geometric levels the split is known to separate V1 and V2 along the
+// split axis, so edges and triangles are coded by where their other
+// vertices lie against the split plane, and edges also by the codes already
+// given to their fan neighbours (docs/FORMAT.md).
 //
 // Triangles and tetrahedra are oriented. A child that inherits its parent's
 // tuple keeps the parent's orientation; the second copy of a code-3 simplex
@@ -58,7 +62,9 @@ struct StarEntry {
   uint8_t record;
   uint8_t geometry;  // edges: class of the other vertex's direction (see classifyEdges)
   uint8_t fanCodes;  // edges: codes already given to fan neighbours, bits 0 (1), 1 (2), 2 (3 or 4)
-  uint32_t fan[2];   // edges: star indices of two edges sharing a triangle with this one
+  // Edges: star indices of two edges sharing a triangle with this one;
+  // triangles: of their two edges through the vertex. kNoSimplex if none.
+  uint32_t links[2];
   uint32_t copy, added;  // children made by codes 3 and 4
 };
 
@@ -125,13 +131,13 @@ class VertexSplitter {
   std::array<bool, 4> aroundReady_{};
   const std::vector<uint32_t>& around(int dimension);
   // Code models: [dimension][possible set][step of the sequential binarisation].
-  static constexpr int kEdgeClasses = 25;
   BitModel codeModels_[4][16][3];
   // Triangles at geometric levels: [class of their two other vertices'
   // directions][possible set][step] (what separates a tetrahedral mesh's
   // star in two).
   static constexpr int kTriangleClasses = 18;
   BitModel triangleModels_[kTriangleClasses][16][3];
+  static constexpr int kEdgeClasses = 25;
   // Edges: [cut edges so far][fan codes][class][all four codes possible]
   // (an edge's only face is the vertex, coded 3 or 4, so it has two sets).
   BitModel edgeModels_[3][8][kEdgeClasses][2][3];
@@ -210,7 +216,7 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, Ora
     if (entry.dimension == 1) {
       cutEdges += entry.code == 4;
       const uint8_t bit = uint8_t(1u << std::min(entry.code - 1, 2));
-      for (const uint32_t neighbour : entry.fan)
+      for (const uint32_t neighbour : entry.links)
         if (neighbour != kNoSimplex) star_[neighbour].fanCodes |= bit;
     }
     ++statistics_.codes[entry.dimension][entry.code - 1];

@@ -75,6 +75,15 @@ inline ReadResult readText(io::Format format, const std::string& text, bool weld
   return readBytes(format, bytesOf(text), weld);
 }
 
+// Writes `complex` in `format` to memory and reads it back.
+inline ReadResult writeThenRead(io::Format format, const Complex& complex,
+                                const io::WriteOptions& options = {}) {
+  std::vector<uint8_t> bytes;
+  const Status written = io::writeMemory(format, complex, bytes, options);
+  EXPECT_TRUE(written.ok()) << written.message;
+  return readBytes(format, bytes);
+}
+
 // A failed read: an InvalidInput status whose one-line message contains
 // every one of `parts`, and an emptied complex.
 inline void expectFailure(const ReadResult& result, const std::vector<const char*>& parts) {

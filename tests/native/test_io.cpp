@@ -94,12 +94,10 @@ const Target kAllTargets[] = {
 };
 
 ReadResult writeThenRead(const Target& target, const Complex& complex) {
-  std::vector<uint8_t> bytes;
+  SCOPED_TRACE(target.name);
   io::WriteOptions options;
   options.asciiPly = target.asciiPly;
-  const Status written = io::writeMemory(target.format, complex, bytes, options);
-  EXPECT_TRUE(written.ok()) << target.name << ": " << written.message;
-  return readBytes(target.format, bytes);
+  return kdmesh::test::writeThenRead(target.format, complex, options);
 }
 
 // Builds PLY files byte by byte: header text, then binary values in either

@@ -72,6 +72,15 @@ void expectCorruptionsReadOrFailCleanly(Format format, const std::vector<uint8_t
   }
 }
 
+// Every prefix and corruption of the file written for `complex` reads or
+// fails with a clear error.
+void expectDamagedCopiesReadOrFailCleanly(Format format, const Complex& complex) {
+  std::vector<uint8_t> bytes;
+  ASSERT_TRUE(io::writeMemory(format, complex, bytes).ok());
+  expectPrefixesReadOrFailCleanly(format, bytes, false);
+  expectCorruptionsReadOrFailCleanly(format, bytes);
+}
+
 // Floats that text formats get wrong when they print too few digits, parse
 // via double, or drop the sign of zero, plus random bit patterns.
 std::vector<float> awkwardPositions(size_t vertices) {
@@ -355,13 +364,6 @@ TEST(IoStl, ExtensionNameAndNoWriter) {
 // Medit
 // ---------------------------------------------------------------------------
 
-ReadResult writeThenRead(Format format, const Complex& complex) {
-  std::vector<uint8_t> bytes;
-  const Status written = io::writeMemory(format, complex, bytes);
-  EXPECT_TRUE(written.ok()) << written.message;
-  return readBytes(format, bytes);
-}
-
 void expectSameComplex(const Complex& actual, const Complex& expected) {
   EXPECT_EQ(bitsOf(actual.positions), bitsOf(expected.positions));
   EXPECT_EQ(actual.points, expected.points);
@@ -370,27 +372,34 @@ void expectSameComplex(const Complex& actual, const Complex& expected) {
   EXPECT_EQ(actual.tetrahedra, expected.tetrahedra);
 }
 
-TEST(IoMedit, RoundTripKeepsBitsOrientationAndEverySimplexType) {
-  const Complex c = mixedComplex();
-  const ReadResult back = writeThenRead(Format::Medit, c);
-  ASSERT_TRUE(back.status.ok()) << back.status.message;
+// `complex` and a cloud of awkward floats come back from `format` exactly,
+// without notes; returns the text written for `complex`.
+std::string expectExactRoundTrip(Format format, const Complex& complex) {
+  const ReadResult back = writeThenRead(format, complex);
+  EXPECT_TRUE(back.status.ok()) << back.status.message;
   EXPECT_TRUE(back.notes.empty()) << joined(back.notes);
-  expectSameComplex(back.complex, c);
+  expectSameComplex(back.complex, complex);
 
   Complex cloud;
   cloud.positions = awkwardPositions(500);
-  const ReadResult cloudBack = writeThenRead(Format::Medit, cloud);
-  ASSERT_TRUE(cloudBack.status.ok()) << cloudBack.status.message;
+  const ReadResult cloudBack = writeThenRead(format, cloud);
+  EXPECT_TRUE(cloudBack.status.ok()) << cloudBack.status.message;
   expectSameComplex(cloudBack.complex, cloud);
 
   std::vector<uint8_t> bytes;
-  ASSERT_TRUE(io::writeMemory(Format::Medit, c, bytes).ok());
-  const std::string text(bytes.begin(), bytes.end());
+  EXPECT_TRUE(io::writeMemory(format, complex, bytes).ok());
+  return std::string(bytes.begin(), bytes.end());
+}
+
+TEST(IoMedit, RoundTripKeepsBitsOrientationAndEverySimplexType) {
+  const Complex c = mixedComplex();
+  const std::string text = expectExactRoundTrip(Format::Medit, c);
   EXPECT_EQ(text.rfind("MeshVersionFormatted 1\nDimension 3\nVertices\n12\n", 0), 0u) << text;
   EXPECT_NE(text.find("Triangles\n3\n3 2 1 0\n"), std::string::npos) << text;
   EXPECT_NE(text.find("\nEnd\n"), std::string::npos);
 
   // Explicit points on used vertices have no place in Medit.
+  std::vector<uint8_t> bytes;
   Complex withPoint = c;
   withPoint.points = {0};
   EXPECT_EQ(io::writeMemory(Format::Medit, withPoint, bytes).code, ErrorCode::InvalidArgument);
@@ -476,10 +485,7 @@ TEST(IoMedit, BadInputNamesTheLineAndKeyword) {
                 {"Hexahedra", "more than the rest of the file"});
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::milliseconds(200));
 
-  std::vector<uint8_t> bytes;
-  ASSERT_TRUE(io::writeMemory(Format::Medit, mixedComplex(), bytes).ok());
-  expectPrefixesReadOrFailCleanly(Format::Medit, bytes, false);
-  expectCorruptionsReadOrFailCleanly(Format::Medit, bytes);
+  expectDamagedCopiesReadOrFailCleanly(Format::Medit, mixedComplex());
 }
 
 TEST(IoMedit, ExtensionAndName) {
@@ -622,12 +628,9 @@ TEST(IoTetgen, BadInputNamesTheFileLineAndTetrahedron) {
                 {"more than the rest of the file"});
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::milliseconds(200));
 
-  std::vector<uint8_t> bytes;
   Complex cloud;
   cloud.positions = awkwardPositions(20);
-  ASSERT_TRUE(io::writeMemory(Format::TetGen, cloud, bytes).ok());
-  expectPrefixesReadOrFailCleanly(Format::TetGen, bytes, false);
-  expectCorruptionsReadOrFailCleanly(Format::TetGen, bytes);
+  expectDamagedCopiesReadOrFailCleanly(Format::TetGen, cloud);
 }
 
 TEST(IoTetgen, WritersRefuseEdgesTrianglesAndTetrahedraInMemory) {
@@ -668,20 +671,7 @@ TEST(IoTetgen, ExtensionsAndName) {
 TEST(IoVtk, RoundTripKeepsBitsOrientationPointsAndEverySimplexType) {
   Complex c = mixedComplex();
   c.points = {11, 0};  // explicit points, even on a used vertex
-  const ReadResult back = writeThenRead(Format::Vtk, c);
-  ASSERT_TRUE(back.status.ok()) << back.status.message;
-  EXPECT_TRUE(back.notes.empty()) << joined(back.notes);
-  expectSameComplex(back.complex, c);
-
-  Complex cloud;
-  cloud.positions = awkwardPositions(500);
-  const ReadResult cloudBack = writeThenRead(Format::Vtk, cloud);
-  ASSERT_TRUE(cloudBack.status.ok()) << cloudBack.status.message;
-  expectSameComplex(cloudBack.complex, cloud);
-
-  std::vector<uint8_t> bytes;
-  ASSERT_TRUE(io::writeMemory(Format::Vtk, c, bytes).ok());
-  const std::string text(bytes.begin(), bytes.end());
+  const std::string text = expectExactRoundTrip(Format::Vtk, c);
   EXPECT_EQ(text.rfind("# vtk DataFile Version 3.0\n", 0), 0u) << text;
   EXPECT_NE(text.find("POINTS 12 float\n"), std::string::npos);
   EXPECT_NE(text.find("CELLS 9 32\n1 11\n1 0\n2 9 10\n"), std::string::npos) << text;
@@ -841,10 +831,7 @@ TEST(IoVtk, BadInputIsRejectedWithTheLine) {
                 {"line 6", "more than the rest of the file"});
   EXPECT_LT(std::chrono::steady_clock::now() - start, std::chrono::milliseconds(200));
 
-  std::vector<uint8_t> bytes;
-  ASSERT_TRUE(io::writeMemory(Format::Vtk, mixedComplex(), bytes).ok());
-  expectPrefixesReadOrFailCleanly(Format::Vtk, bytes, false);
-  expectCorruptionsReadOrFailCleanly(Format::Vtk, bytes);
+  expectDamagedCopiesReadOrFailCleanly(Format::Vtk, mixedComplex());
 }
 
 TEST(IoVtk, FilesOnDiskExtensionAndName) {
