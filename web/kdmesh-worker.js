@@ -35,30 +35,53 @@ function boundaryOfTetrahedra(tetrahedra) {
   return out;
 }
 
-// Area-weighted vertex normals of the triangles: computed here, off the
-// page's main thread, and sent with the snapshot.
-function vertexNormals(positions, triangleLists) {
-  const normals = new Float32Array(positions.length);
-  for (const triangles of triangleLists) {
-    for (let t = 0; t < triangles.length; t += 3) {
-      const a = 3 * triangles[t], b = 3 * triangles[t + 1], c = 3 * triangles[t + 2];
-      const ux = positions[b] - positions[a], uy = positions[b + 1] - positions[a + 1], uz = positions[b + 2] - positions[a + 2];
-      const vx = positions[c] - positions[a], vy = positions[c + 1] - positions[a + 1], vz = positions[c + 2] - positions[a + 2];
-      const nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = ux * vy - uy * vx;
-      for (const i of [a, b, c]) {
-        normals[i] += nx;
-        normals[i + 1] += ny;
-        normals[i + 2] += nz;
-      }
+// Area-weighted vertex normals of the triangles, written into `normals`:
+// computed here, off the page's main thread, and sent with the snapshot.
+function vertexNormals(positions, triangles, normals) {
+  for (let t = 0; t < triangles.length; t += 3) {
+    const a = 3 * triangles[t], b = 3 * triangles[t + 1], c = 3 * triangles[t + 2];
+    const ux = positions[b] - positions[a], uy = positions[b + 1] - positions[a + 1], uz = positions[b + 2] - positions[a + 2];
+    const vx = positions[c] - positions[a], vy = positions[c + 1] - positions[a + 1], vz = positions[c + 2] - positions[a + 2];
+    const nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = ux * vy - uy * vx;
+    for (const i of [a, b, c]) {
+      normals[i] += nx;
+      normals[i + 1] += ny;
+      normals[i + 2] += nz;
     }
   }
-  for (let i = 0; i < normals.length; i += 3) {
+  for (let i = 0; i < positions.length; i += 3) {
     const length = Math.hypot(normals[i], normals[i + 1], normals[i + 2]) || 1;
     normals[i] /= length;
     normals[i + 1] /= length;
     normals[i + 2] /= length;
   }
-  return normals;
+}
+
+// Lists drawn together, one after the other in one new array of at least
+// `capacity` elements (the final model's size, from the header), so that the
+// page adopts the array as a GPU buffer's storage without copying or
+// reallocating at every level. Returns views of the lists in it.
+function pack(Type, lists, capacity) {
+  const length = lists.reduce((sum, list) => sum + list.length, 0);
+  const storage = new Type(Math.max(length, capacity));
+  let offset = 0;
+  return lists.map((list) => {
+    storage.set(list, offset);
+    offset += list.length;
+    return storage.subarray(offset - list.length, offset);
+  });
+}
+
+// Smallest and largest coordinates, [x, y, z, x, y, z].
+function bounds(positions) {
+  const box = [Infinity, Infinity, Infinity, -Infinity, -Infinity, -Infinity];
+  for (let i = 0; i < positions.length; i += 3) {
+    for (let a = 0; a < 3; ++a) {
+      box[a] = Math.min(box[a], positions[i + a]);
+      box[a + 3] = Math.max(box[a + 3], positions[i + a]);
+    }
+  }
+  return box;
 }
 
 // Every edge of the tetrahedra once, for the wireframe view.
@@ -81,17 +104,34 @@ function edgesOfTetrahedra(tetrahedra) {
 
 function sendSnapshot() {
   if (!decoder || !wanted || !changed) return;
-  const model = decoder.snapshot();
-  model.boundary = model.tetrahedra.length ? boundaryOfTetrahedra(model.tetrahedra) : new Uint32Array(0);
-  model.tetrahedronEdges = model.tetrahedra.length && wireframe ? edgesOfTetrahedra(model.tetrahedra) : new Uint32Array(0);
-  const surface = model.triangles.length + model.boundary.length > 0;
-  model.normals = surface ? vertexNormals(model.positions, [model.triangles, model.boundary]) : new Float32Array(0);
-  model.parents = geomorph ? decoder.parents() : new Uint32Array(0);
-  model.progress = decoder.progress;
+  const live = decoder.snapshot({ copy: false });  // views, valid until the next call on the decoder
+  const boundary = live.tetrahedra.length ? boundaryOfTetrahedra(live.tetrahedra) : new Uint32Array(0);
+  const tetrahedronEdges = live.tetrahedra.length && wireframe ? edgesOfTetrahedra(live.tetrahedra) : new Uint32Array(0);
+  // Capacities: the final maximal simplices and isolated vertices, and for
+  // tetrahedra up to four boundary triangles and six edges each.
+  const { vertexCount, simplexCounts: [pointCount, edgeCount, triangleCount, tetrahedronCount] } = decoder.header;
+  const [positions] = pack(Float32Array, [live.positions], 3 * vertexCount);
+  const [points] = pack(Uint32Array, [live.points], pointCount);
+  const [edges, tetrahedronEdgesInPlace] = pack(Uint32Array, [live.edges, tetrahedronEdges],
+    2 * (edgeCount + (wireframe ? 6 * tetrahedronCount : 0)));
+  const [triangles, boundaryInPlace] = pack(Uint32Array, [live.triangles, boundary], 3 * (triangleCount + 4 * tetrahedronCount));
+  const model = {
+    ...live, positions, points, edges, triangles, tetrahedra: live.tetrahedra.slice(),
+    boundary: boundaryInPlace, tetrahedronEdges: tetrahedronEdgesInPlace,
+    bounds: bounds(positions),
+    normals: new Float32Array(0),
+    parents: geomorph ? decoder.parents() : new Uint32Array(0),
+    progress: decoder.progress,
+  };
+  if (triangles.length + boundary.length > 0) {
+    // As large as the positions' storage, for the same reason.
+    model.normals = new Float32Array(positions.buffer.byteLength / 4).subarray(0, positions.length);
+    vertexNormals(positions, new Uint32Array(triangles.buffer, 0, triangles.length + boundary.length), model.normals);
+  }
   wanted = false;
   changed = false;
-  const buffers = [model.positions, model.points, model.edges, model.triangles, model.tetrahedra, model.boundary,
-    model.tetrahedronEdges, model.normals, model.parents].map((a) => a.buffer).filter((b, i, all) => b.byteLength && all.indexOf(b) === i);
+  const buffers = [positions, points, edges, triangles, model.tetrahedra, model.normals, model.parents]
+    .map((a) => a.buffer).filter((b, i, all) => b.byteLength && all.indexOf(b) === i);
   postMessage({ type: 'snapshot', model }, buffers);
 }
 

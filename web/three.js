@@ -9,39 +9,65 @@
 // Decoding runs in a module worker; bytes are fed as fetch delivers them and
 // the geometry is refreshed at most once per animation frame. The returned
 // THREE.Group holds a Mesh (triangles, and the boundary of tetrahedra), a
-// LineSegments (edges) and a Points (isolated vertices).
+// LineSegments (edges) and a Points (isolated vertices), drawn with the
+// loader's `materials` (shared by every model it loads; change or replace
+// them before loading). `await loader.prepareRenderer(renderer, camera, scene)`
+// before streaming keeps the first refinements from blocking the page.
 import {
-  Box3, BufferAttribute, BufferGeometry, DoubleSide, Group, LineBasicMaterial, LineSegments, Loader, Mesh,
-  MeshStandardMaterial, Points, PointsMaterial, Sphere,
+  Box3, BufferAttribute, BufferGeometry, DoubleSide, Float32BufferAttribute, Group, LineBasicMaterial, LineSegments, Loader, Mesh,
+  MeshStandardMaterial, Points, PointsMaterial, Sphere, Vector3,
 } from 'three';
 
+// After the next frame, in a task of its own: a refinement applied inside
+// the frame's callbacks would lengthen the task that also draws it.
 const nextFrame = () =>
-  new Promise((resolve) => (typeof requestAnimationFrame === 'function' ? requestAnimationFrame(() => resolve()) : setTimeout(resolve, 16)));
+  new Promise((resolve) =>
+    typeof requestAnimationFrame === 'function' ? requestAnimationFrame(() => setTimeout(resolve, 0)) : setTimeout(resolve, 16));
 
-// Writes `parts` (typed arrays of one type) one after the other into a
-// geometry's attribute, replacing the attribute only when they no longer fit:
-// refinement reuses buffers sized for the final model (from the header)
-// instead of allocating at every step, and lists that are drawn together
-// (triangles and the boundary of tetrahedra) are copied once, straight into
-// place. Returns the attribute; the caller sets the draw range.
-function updateAttribute(geometry, name, parts, itemSize, capacity) {
-  const length = parts.reduce((sum, part) => sum + part.length, 0);
+// The whole array behind a view from the worker.
+const storageOf = (view) => new view.constructor(view.buffer);
+
+// Makes `storage` the geometry's attribute `name`, of which the first `used`
+// elements are the current level. The worker sizes storage for the final
+// model (from the header) and hands it over without a copy; an attribute
+// whose storage keeps its size keeps its GPU buffer, so refinement neither
+// copies nor reallocates on the page. Returns the attribute; the caller sets
+// the draw range.
+function adoptAttribute(geometry, name, storage, used, itemSize) {
   let attribute = name === 'index' ? geometry.index : geometry.getAttribute(name);
-  if (!attribute || attribute.array.length < length) {
-    const storage = new parts[0].constructor(Math.max(length, capacity * itemSize));
+  if (attribute && attribute.array.byteLength === storage.byteLength) {
+    attribute.array = storage;
+  } else {
     attribute = new BufferAttribute(storage, itemSize);
     if (name === 'index') geometry.setIndex(attribute);
     else geometry.setAttribute(name, attribute);
   }
-  let offset = 0;
-  for (const part of parts) {
-    attribute.array.set(part, offset);
-    offset += part.length;
-  }
-  attribute.clearUpdateRanges?.();
-  attribute.addUpdateRange?.(0, length);
+  usedBytes.set(storage, used * storage.BYTES_PER_ELEMENT);
+  attribute.clearUpdateRanges();
+  attribute.addUpdateRange(0, used);
   attribute.needsUpdate = true;
   return attribute;
+}
+
+// Buffers are sized for the final model from the first refinement on, but
+// writing a fresh GPU buffer is slow (under software WebGL in Chromium, 3 ms
+// per MB, against 0.2 ms per MB to rewrite one): the 21 MB of the dragon's
+// buffers would block the page for 60-360 ms. So on renderers passed to
+// prepareRenderer(), a buffer created from one of these arrays receives only
+// the array's first `usedBytes` (the rest of a new WebGL buffer is zeros),
+// and later refinements touch the remainder a little at a time.
+const usedBytes = new WeakMap();
+const preparedContexts = new WeakSet();
+function createBuffersFromUsedBytes(gl) {
+  if (preparedContexts.has(gl)) return;
+  preparedContexts.add(gl);
+  const bufferData = gl.bufferData;
+  gl.bufferData = function (target, data, usage, ...rest) {
+    const used = rest.length === 0 && ArrayBuffer.isView(data) ? usedBytes.get(data) : undefined;
+    if (used === undefined) return bufferData.call(this, target, data, usage, ...rest);
+    bufferData.call(this, target, data.byteLength, usage);
+    if (used > 0) this.bufferSubData(target, 0, data, 0, used / data.BYTES_PER_ELEMENT);
+  };
 }
 
 export class KDMeshLoader extends Loader {
@@ -50,6 +76,58 @@ export class KDMeshLoader extends Loader {
     this.wasmSource = undefined;
     this.workerUrl = new URL('./kdmesh-worker.js', import.meta.url);
     this.workers = new Set();
+    this.materials = {
+      surface: new MeshStandardMaterial({ color: 0xb8c4d6, roughness: 0.6, metalness: 0.05, side: DoubleSide }),
+      lines: new LineBasicMaterial({ color: 0x33475b }),
+      points: new PointsMaterial({ color: 0x1f6feb, size: 2, sizeAttenuation: false }),
+    };
+  }
+
+  /**
+   * Prepares `renderer` to draw the loader's models in `scene` (whose lights
+   * decide the shaders) without blocking the page, as measured in Chromium:
+   *  - compiles the materials' shaders and draws a sample of each kind of
+   *    object once, hidden behind `camera` (the first draw with a new shader
+   *    waits for the GPU: hundreds of milliseconds under software WebGL);
+   *  - fills the GPU buffers of models as their content grows, not at once
+   *    (see createBuffersFromUsedBytes).
+   * Call it before streaming starts.
+   */
+  async prepareRenderer(renderer, camera, scene) {
+    createBuffersFromUsedBytes(renderer.getContext());
+    const sample = this.#createGroup();
+    const behind = camera.localToWorld(new Vector3(0, 0, 1));
+    const corners = new Float32BufferAttribute([...behind.toArray(), ...behind.toArray(), ...behind.toArray()], 3);
+    const [surface, lines, points] = sample.children;
+    surface.geometry.setAttribute('normal', new Float32BufferAttribute([0, 0, 1, 0, 0, 1, 0, 0, 1], 3));
+    // 32-bit indices like the models' (a different index type is a different
+    // pipeline for the GPU).
+    surface.geometry.setIndex(new BufferAttribute(new Uint32Array([0, 1, 2]), 1));
+    lines.geometry.setIndex(new BufferAttribute(new Uint32Array([0, 1]), 1));
+    points.geometry.setIndex(new BufferAttribute(new Uint32Array([0]), 1));
+    for (const object of sample.children) {
+      object.geometry.setAttribute('position', corners);
+      object.frustumCulled = false;
+    }
+    try {
+      await renderer.compileAsync(sample, camera, scene);
+      scene.add(sample);
+      renderer.render(scene, camera);
+    } finally {
+      scene.remove(sample);
+      for (const object of sample.children) object.geometry.dispose();
+    }
+  }
+
+  // The objects of one model: their geometries are the model's own, the
+  // materials the loader's.
+  #createGroup() {
+    const group = new Group();
+    group.name = 'kdmesh';
+    const { surface, lines, points } = this.materials;
+    group.add(new Mesh(new BufferGeometry(), surface), new LineSegments(new BufferGeometry(), lines),
+      new Points(new BufferGeometry(), points));
+    return group;
   }
 
   /** Self-hosting: where the worker loads kdmesh-wasm.wasm from (default: embedded). */
@@ -93,7 +171,9 @@ export class KDMeshLoader extends Loader {
    * tetrahedra: 'boundary' (default: the faces in exactly one tetrahedron) or
    * 'wireframe' (the boundary plus every edge of the tetrahedra), geomorph
    * (true: new vertices glide from their parent's position over
-   * geomorphFrames frames, default 12; onAnimate(model) after each frame).
+   * geomorphFrames frames, default 12), onAnimate(model) whenever the model
+   * changes between refinements (geomorph frames; a level's vertices, which
+   * reach the GPU a frame before its simplices).
    */
   loadProgressive(url, options = {}) {
     const model = this.#start(options);
@@ -116,12 +196,9 @@ export class KDMeshLoader extends Loader {
   #start(options) {
     const worker = new Worker(this.workerUrl, { type: 'module' });
     this.workers.add(worker);
-    const group = new Group();
-    group.name = 'kdmesh';
-    const surface = new Mesh(new BufferGeometry(), new MeshStandardMaterial({ color: 0xb8c4d6, roughness: 0.6, metalness: 0.05, side: DoubleSide }));
-    const lines = new LineSegments(new BufferGeometry(), new LineBasicMaterial({ color: 0x33475b }));
-    const points = new Points(new BufferGeometry(), new PointsMaterial({ color: 0x1f6feb, size: 2, sizeAttenuation: false }));
-    group.add(surface, lines, points);
+    const group = this.#createGroup();
+    const [surface, lines, points] = group.children;
+    for (const object of group.children) object.visible = false;  // until it has simplices
 
     const stats = { refinements: 0, bytesReceived: 0, bytesExpected: 0, header: null, complete: false, model: null };
     let settle;
@@ -159,21 +236,22 @@ export class KDMeshLoader extends Loader {
       requestAnimationFrame(step);
     };
 
-    const apply = (model) => {
-      const capacity = stats.header?.vertexCount ?? model.vertexCount;
+    const applyVertices = (model) => {
+      let drawn = storageOf(model.positions);
       let start = null;
       if (options.geomorph && previous) {
-        start = new Float32Array(model.positions.length);
+        drawn = new Float32Array(drawn.length);  // moves between the levels; model.positions stays
         for (let v = 0; v < model.vertexCount; ++v) {
           let ancestor = v;
           while (ancestor >= previous.count) ancestor = model.parents[ancestor];
-          start[3 * v] = previous.positions[3 * ancestor];
-          start[3 * v + 1] = previous.positions[3 * ancestor + 1];
-          start[3 * v + 2] = previous.positions[3 * ancestor + 2];
+          drawn[3 * v] = previous.positions[3 * ancestor];
+          drawn[3 * v + 1] = previous.positions[3 * ancestor + 1];
+          drawn[3 * v + 2] = previous.positions[3 * ancestor + 2];
         }
+        start = drawn.slice(0, model.positions.length);
       }
       if (options.geomorph) previous = { positions: model.positions, count: model.vertexCount };
-      const position = updateAttribute(surface.geometry, 'position', [start ?? model.positions], 3, capacity);
+      const position = adoptAttribute(surface.geometry, 'position', drawn, model.positions.length, 3);
       lines.geometry.setAttribute('position', position);
       points.geometry.setAttribute('position', position);
       if (start) morph(position, start, model.positions, model.vertexCount);
@@ -181,19 +259,22 @@ export class KDMeshLoader extends Loader {
       // Normals come from the worker. On the final dragon (871k triangles,
       // Node 20) the worker's loop takes 90 ms and three.js's
       // computeVertexNormals 140 ms, which would block the main thread.
-      if (model.normals.length) updateAttribute(surface.geometry, 'normal', [model.normals], 3, capacity);
+      if (model.normals.length) adoptAttribute(surface.geometry, 'normal', storageOf(model.normals), model.normals.length, 3);
+    };
+    const applyLists = (model) => {
+      // Lists drawn together lie one after the other in one storage (see the worker).
       const lists = [
-        [surface, [model.triangles, model.boundary]],
-        [lines, [model.edges, model.tetrahedronEdges]],
-        [points, [model.points]],
+        [surface, model.triangles, model.boundary.length],
+        [lines, model.edges, model.tetrahedronEdges.length],
+        [points, model.points, 0],
       ];
-      // One bounding volume from the current vertices serves all three
-      // objects (the shared attribute is padded to the final size).
-      const box = new Box3().setFromArray(model.positions);
+      // One bounding volume from the current vertices (the worker's) serves
+      // all three objects.
+      const box = new Box3().setFromArray(model.bounds);
       const sphere = box.getBoundingSphere(new Sphere());
-      for (const [object, parts] of lists) {
-        const count = parts.reduce((sum, part) => sum + part.length, 0);
-        if (count) updateAttribute(object.geometry, 'index', parts, 1, count);
+      for (const [object, first, more] of lists) {
+        const count = first.length + more;
+        if (count) adoptAttribute(object.geometry, 'index', storageOf(first), count, 1);
         object.geometry.setDrawRange(0, count);
         object.geometry.boundingBox = box.clone();
         object.geometry.boundingSphere = sphere.clone();
@@ -204,10 +285,18 @@ export class KDMeshLoader extends Loader {
     // A snapshot waits for the next frame; an error that arrives meanwhile
     // is reported after it is drawn, so the last good level stays on screen.
     let drawing = Promise.resolve();
+    // The vertices and the lists of a level reach the GPU in separate
+    // frames, which halves the largest upload of a frame; meanwhile the
+    // previous level's lists are drawn over the new positions (vertices keep
+    // their ids, and new ones are not yet referenced).
     const draw = async (model) => {
       await nextFrame();  // at most one geometry update per frame
       if (finished) return;
-      apply(model);
+      applyVertices(model);
+      options.onAnimate?.(group);
+      await nextFrame();
+      if (finished) return;
+      applyLists(model);
       stats.refinements += 1;
       stats.complete = model.complete;
       stats.model = model;
@@ -249,8 +338,10 @@ export class KDMeshLoader extends Loader {
     return group;
   }
 
+  /** Stops every decoding worker and frees the materials. */
   dispose() {
     for (const worker of this.workers) worker.terminate();
     this.workers.clear();
+    for (const material of Object.values(this.materials)) material.dispose();
   }
 }
