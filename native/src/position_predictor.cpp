@@ -49,16 +49,18 @@ PositionPredictor::PositionPredictor(const SplitSchedule& schedule)
   primeModels(ModelFamily::OneVertexSplits, models_.data());
   primeModels(ModelFamily::OneVertexByPlane, planeModels_.data());
   primeModels(ModelFamily::OneVertexByCentroid, centroidModels_.data());
-  width_.resize(size_t(schedule.levels) + 1);
-  for (size_t level = 0; level < width_.size(); ++level)
-    for (int a = 0; a < 3; ++a)
-      width_[level][size_t(a)] =
-          std::ldexp(1.0, schedule.bits[size_t(a)] - schedule.consumed[level][size_t(a)]);
+  levels_.resize(size_t(schedule.levels) + 1);
+  for (size_t level = 0; level < levels_.size(); ++level)
+    for (int a = 0; a < 3; ++a) {
+      const double width = std::ldexp(1.0, schedule.bits[size_t(a)] - schedule.consumed[level][size_t(a)]);
+      levels_[level].width[a] = width;
+      levels_[level].centreOffset[a] = (width - 1) * 0.5;
+    }
 }
 
 void PositionPredictor::centre(const Place& place, double out[3]) const {
-  const std::array<double, 3>& width = width_[place.level];
-  for (int a = 0; a < 3; ++a) out[a] = double(place.prefix[a]) * width[size_t(a)] + (width[size_t(a)] - 1) * 0.5;
+  const LevelGeometry& cell = levels_[place.level];
+  for (int a = 0; a < 3; ++a) out[a] = double(place.prefix[a]) * cell.width[a] + cell.centreOffset[a];
 }
 
 void PositionPredictor::snapshotNeighbours(const SimplexStore& store, uint64_t splits) {
@@ -88,7 +90,7 @@ PositionPredictor::Features PositionPredictor::features(const Neighbourhood& aro
   Features f;
   const int axis = axis_[size_t(level)];
   double halfWidth[3];
-  for (int a = 0; a < 3; ++a) halfWidth[a] = width_[size_t(level)][size_t(a)] * 0.5;
+  for (int a = 0; a < 3; ++a) halfWidth[a] = levels_[size_t(level)].width[a] * 0.5;
   const double inverse = 1.0 / double(around.count);
   double centroid[3];  // relative to the cell centre
   for (int a = 0; a < 3; ++a) centroid[a] = around.sum[a] * inverse;
@@ -120,13 +122,39 @@ bool PositionPredictor::gather(uint32_t vertex, Neighbourhood& around) const {
   if (size_t(vertex) + 1 >= firstNeighbour_.size()) return false;
   const uint32_t* neighbour = neighbours_.data() + firstNeighbour_[vertex];
   const uint32_t count = firstNeighbour_[vertex + 1] - firstNeighbour_[vertex];
-  centre(places_[vertex], around.at);
+  if (count == 0) return false;
+  double at[3];
+  centre(places_[vertex], at);
+  // Scalars rather than arrays: this is the decoder's hottest loop, and
+  // array temporaries cost store-to-load stalls.
+  double sumX = 0, sumY = 0, sumZ = 0, normalX = 0, normalY = 0, normalZ = 0, squared = 0;
+  double previousX = 0, previousY = 0, previousZ = 0;  // the first cross product is zero
   for (uint32_t i = 0; i < count; ++i) {
-    double p[3];
-    centre(places_[neighbour[i]], p);
-    around.add(p);
+    const Place& place = places_[neighbour[i]];
+    const LevelGeometry& cell = levels_[place.level];
+    const double x = double(place.prefix[0]) * cell.width[0] + cell.centreOffset[0] - at[0];
+    const double y = double(place.prefix[1]) * cell.width[1] + cell.centreOffset[1] - at[1];
+    const double z = double(place.prefix[2]) * cell.width[2] + cell.centreOffset[2] - at[2];
+    sumX += x;
+    sumY += y;
+    sumZ += z;
+    squared += x * x;
+    squared += y * y;
+    squared += z * z;
+    const double crossX = previousY * z - previousZ * y;
+    const double crossY = previousZ * x - previousX * z;
+    const double crossZ = previousX * y - previousY * x;
+    // copysign, not a branch: the signs are a coin toss for the branch predictor.
+    const double sign = std::copysign(1.0, crossX * normalX + crossY * normalY + crossZ * normalZ);
+    normalX += sign * crossX;
+    normalY += sign * crossY;
+    normalZ += sign * crossZ;
+    previousX = x;
+    previousY = y;
+    previousZ = z;
   }
-  return count > 0;
+  around = {{sumX, sumY, sumZ}, {normalX, normalY, normalZ}, squared, count};
+  return true;
 }
 
 bool PositionPredictor::contextsOf(uint32_t vertex, int level, SingleContexts& c) {

@@ -116,30 +116,17 @@ class PositionPredictor {
     uint32_t level;
   };
 
-  // Neighbours' cell centres, summed relative to the vertex's cell centre.
+  // Sums over the neighbours' cell centres, relative to the vertex's cell
+  // centre; the normal: see the top of this file.
   struct Neighbourhood {
-    double at[3];
-    double sum[3] = {0, 0, 0}, normal[3] = {0, 0, 0}, previous[3] = {0, 0, 0};
-    double squaredDistance = 0;
-    uint32_t count = 0;
-    void add(const double position[3]) {
-      double p[3];
-      for (int a = 0; a < 3; ++a) {
-        p[a] = position[a] - at[a];
-        sum[a] += p[a];
-        squaredDistance += p[a] * p[a];
-      }
-      // The normal: see the top of this file.
-      if (count > 0) {
-        const double cross[3] = {previous[1] * p[2] - previous[2] * p[1], previous[2] * p[0] - previous[0] * p[2],
-                                 previous[0] * p[1] - previous[1] * p[0]};
-        // copysign, not a branch: the signs are a coin toss for the branch predictor.
-        const double sign = std::copysign(1.0, cross[0] * normal[0] + cross[1] * normal[1] + cross[2] * normal[2]);
-        for (int a = 0; a < 3; ++a) normal[a] += sign * cross[a];
-      }
-      for (int a = 0; a < 3; ++a) previous[a] = p[a];
-      ++count;
-    }
+    double sum[3], normal[3];
+    double squaredDistance;
+    uint32_t count;
+  };
+  // Cell width per axis at a level, and the offset of a cell's centre from
+  // its lowest grid coordinate.
+  struct LevelGeometry {
+    double width[3], centreOffset[3];
   };
   // The predictions against the split at `level`, in half widths of the
   // cell along the split axis, mirrored so that the plane (or without one,
@@ -165,7 +152,7 @@ class PositionPredictor {
   void centre(const Place& place, double out[3]) const;
 
   std::vector<uint8_t> axis_;                  // split axis per level
-  std::vector<std::array<double, 3>> width_;   // cell width per level and axis
+  std::vector<LevelGeometry> levels_;
   std::vector<Place> places_;
   // The complex's edges as neighbour lists (compressed rows) at the last
   // snapshot: contiguous lists let the lookups of a vertex's neighbours
