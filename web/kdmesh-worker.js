@@ -35,9 +35,11 @@ function boundaryOfTetrahedra(tetrahedra) {
   return out;
 }
 
-// Area-weighted vertex normals of the triangles, written into `normals`:
-// computed here, off the page's main thread, and sent with the snapshot.
-function vertexNormals(positions, triangles, normals) {
+// Area-weighted vertex normals of the triangles: computed here, off the
+// page's main thread, and sent with the snapshot; in storage as large as the
+// positions' (see pack()).
+function vertexNormals(positions, triangles) {
+  const normals = new Float32Array(positions.buffer.byteLength / 4).subarray(0, positions.length);
   for (let t = 0; t < triangles.length; t += 3) {
     const a = 3 * triangles[t], b = 3 * triangles[t + 1], c = 3 * triangles[t + 2];
     const ux = positions[b] - positions[a], uy = positions[b + 1] - positions[a + 1], uz = positions[b + 2] - positions[a + 2];
@@ -55,6 +57,7 @@ function vertexNormals(positions, triangles, normals) {
     normals[i + 1] /= length;
     normals[i + 2] /= length;
   }
+  return normals;
 }
 
 // Lists drawn together, one after the other in one new array of at least
@@ -115,19 +118,15 @@ function sendSnapshot() {
   const [edges, tetrahedronEdgesInPlace] = pack(Uint32Array, [live.edges, tetrahedronEdges],
     2 * (edgeCount + (wireframe ? 6 * tetrahedronCount : 0)));
   const [triangles, boundaryInPlace] = pack(Uint32Array, [live.triangles, boundary], 3 * (triangleCount + 4 * tetrahedronCount));
+  const drawnTriangles = new Uint32Array(triangles.buffer, 0, triangles.length + boundary.length);  // both lists
   const model = {
     ...live, positions, points, edges, triangles, tetrahedra: live.tetrahedra.slice(),
     boundary: boundaryInPlace, tetrahedronEdges: tetrahedronEdgesInPlace,
     bounds: bounds(positions),
-    normals: new Float32Array(0),
+    normals: drawnTriangles.length ? vertexNormals(positions, drawnTriangles) : new Float32Array(0),
     parents: geomorph ? decoder.parents() : new Uint32Array(0),
     progress: decoder.progress,
   };
-  if (triangles.length + boundary.length > 0) {
-    // As large as the positions' storage, for the same reason.
-    model.normals = new Float32Array(positions.buffer.byteLength / 4).subarray(0, positions.length);
-    vertexNormals(positions, new Uint32Array(triangles.buffer, 0, triangles.length + boundary.length), model.normals);
-  }
   wanted = false;
   changed = false;
   const buffers = [positions, points, edges, triangles, model.tetrahedra, model.normals, model.parents]

@@ -87,8 +87,9 @@ export class KDMeshLoader extends Loader {
    * Prepares `renderer` to draw the loader's models in `scene` (whose lights
    * decide the shaders) without blocking the page, as measured in Chromium:
    *  - compiles the materials' shaders and draws a sample of each kind of
-   *    object once, hidden behind `camera` (the first draw with a new shader
-   *    waits for the GPU: hundreds of milliseconds under software WebGL);
+   *    object once, hidden behind `camera` (under software WebGL the first
+   *    draw of a model otherwise took 130-230 ms, even with the shaders
+   *    compiled);
    *  - fills the GPU buffers of models as their content grows, not at once
    *    (see createBuffersFromUsedBytes).
    * Call it before streaming starts.

@@ -58,11 +58,6 @@ PositionPredictor::PositionPredictor(const SplitSchedule& schedule)
     }
 }
 
-void PositionPredictor::centre(const Place& place, double out[3]) const {
-  const LevelGeometry& cell = levels_[place.level];
-  for (int a = 0; a < 3; ++a) out[a] = double(place.prefix[a]) * cell.width[a] + cell.centreOffset[a];
-}
-
 void PositionPredictor::snapshotNeighbours(const SimplexStore& store, uint64_t splits) {
   if (splits == snapshotSplits_) return;
   snapshotSplits_ = splits;
@@ -123,18 +118,16 @@ bool PositionPredictor::gather(uint32_t vertex, Neighbourhood& around) const {
   const uint32_t* neighbour = neighbours_.data() + firstNeighbour_[vertex];
   const uint32_t count = firstNeighbour_[vertex + 1] - firstNeighbour_[vertex];
   if (count == 0) return false;
-  double at[3];
-  centre(places_[vertex], at);
-  // Scalars rather than arrays: this is the decoder's hottest loop, and
-  // array temporaries cost store-to-load stalls.
+  double atX, atY, atZ;
+  centre(places_[vertex], atX, atY, atZ);
   double sumX = 0, sumY = 0, sumZ = 0, normalX = 0, normalY = 0, normalZ = 0, squared = 0;
   double previousX = 0, previousY = 0, previousZ = 0;  // the first cross product is zero
   for (uint32_t i = 0; i < count; ++i) {
-    const Place& place = places_[neighbour[i]];
-    const LevelGeometry& cell = levels_[place.level];
-    const double x = double(place.prefix[0]) * cell.width[0] + cell.centreOffset[0] - at[0];
-    const double y = double(place.prefix[1]) * cell.width[1] + cell.centreOffset[1] - at[1];
-    const double z = double(place.prefix[2]) * cell.width[2] + cell.centreOffset[2] - at[2];
+    double x, y, z;
+    centre(places_[neighbour[i]], x, y, z);
+    x -= atX;
+    y -= atY;
+    z -= atZ;
     sumX += x;
     sumY += y;
     sumZ += z;

@@ -98,7 +98,7 @@ class PositionPredictor {
   // The split axis of a geometric `level`, and the centre of a vertex's
   // current cell in grid units.
   int axis(int level) const { return axis_[size_t(level)]; }
-  void centreOf(uint32_t vertex, double out[3]) const { centre(places_[vertex], out); }
+  void centreOf(uint32_t vertex, double out[3]) const { centre(places_[vertex], out[0], out[1], out[2]); }
 
   const std::vector<BitModel>& models() const { return models_; }
   const std::vector<BitModel>& planeModels() const { return planeModels_; }
@@ -149,7 +149,14 @@ class PositionPredictor {
     bool mirrored;
   };
   bool contextsOf(uint32_t vertex, int level, SingleContexts& contexts);
-  void centre(const Place& place, double out[3]) const;
+  // Scalars rather than an array: gather(), the decoder's hottest loop,
+  // stalled on store-to-load forwarding with array temporaries.
+  void centre(const Place& place, double& x, double& y, double& z) const {
+    const LevelGeometry& cell = levels_[place.level];
+    x = double(place.prefix[0]) * cell.width[0] + cell.centreOffset[0];
+    y = double(place.prefix[1]) * cell.width[1] + cell.centreOffset[1];
+    z = double(place.prefix[2]) * cell.width[2] + cell.centreOffset[2];
+  }
 
   std::vector<uint8_t> axis_;                  // split axis per level
   std::vector<LevelGeometry> levels_;

@@ -205,20 +205,19 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, Ora
     const uint8_t code = uint8_t((entry.record & split_record::kCodeMask) + 1);
     if (entry.dimension == 1) {
       const bool all = possible == 0b1111;
-      entry.code = codeSymbol(coder, edgeModels_[std::min(cutEdges, 2)][entry.fanCodes][entry.geometry][all],
-                              possible, code, edgeDirectionModels_[entry.geometry][all], std::min(cutEdges, 2));
+      const int cut = std::min(cutEdges, 2);
+      entry.code = codeSymbol(coder, edgeModels_[cut][entry.fanCodes][entry.geometry][all], possible, code,
+                              edgeDirectionModels_[entry.geometry][all], cut);
+      cutEdges += entry.code == 4;
+      const uint8_t bit = uint8_t(1u << std::min(entry.code - 1, 2));
+      for (const uint32_t neighbour : entry.links)
+        if (neighbour != kNoSimplex) star_[neighbour].fanCodes |= bit;
     } else if (entry.dimension == 2 && geometric) {
       entry.code = codeSymbol(coder, triangleModels_[triangleClass(entry)][possible], possible, code);
     } else {
       entry.code = codeSymbol(coder, codeModels_[entry.dimension][possible], possible, code);
     }
     codedThree |= entry.code == 3;
-    if (entry.dimension == 1) {
-      cutEdges += entry.code == 4;
-      const uint8_t bit = uint8_t(1u << std::min(entry.code - 1, 2));
-      for (const uint32_t neighbour : entry.links)
-        if (neighbour != kNoSimplex) star_[neighbour].fanCodes |= bit;
-    }
     ++statistics_.codes[entry.dimension][entry.code - 1];
   }
 
