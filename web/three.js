@@ -15,7 +15,7 @@
 // before streaming keeps the first refinements from blocking the page.
 import {
   Box3, BufferAttribute, BufferGeometry, DoubleSide, Float32BufferAttribute, Group, LineBasicMaterial, LineSegments, Loader, Mesh,
-  MeshStandardMaterial, Points, PointsMaterial, Sphere, Vector3,
+  MeshStandardMaterial, Points, PointsMaterial, Scene, ShaderMaterial, Sphere, Vector3, WebGLRenderTarget,
 } from 'three';
 
 // After the next frame, in a task of its own: a refinement applied inside
@@ -27,13 +27,10 @@ const nextFrame = () =>
 // The whole array behind a view from the worker.
 const storageOf = (view) => new view.constructor(view.buffer);
 
-// Makes `storage` the geometry's attribute `name`, of which the first `used`
-// elements are the current level. The worker sizes storage for the final
-// model (from the header) and hands it over without a copy; an attribute
-// whose storage keeps its size keeps its GPU buffer, so refinement neither
-// copies nor reallocates on the page. Returns the attribute; the caller sets
-// the draw range.
-function adoptAttribute(geometry, name, storage, used, itemSize) {
+// Makes `storage` the geometry's attribute `name`, without a copy: the
+// worker sizes storage for the final model (from the header) and hands it
+// over, and an attribute whose storage keeps its size keeps its GPU buffer.
+function adoptAttribute(geometry, name, storage, itemSize) {
   let attribute = name === 'index' ? geometry.index : geometry.getAttribute(name);
   if (attribute && attribute.array.byteLength === storage.byteLength) {
     attribute.array = storage;
@@ -42,20 +39,121 @@ function adoptAttribute(geometry, name, storage, used, itemSize) {
     if (name === 'index') geometry.setIndex(attribute);
     else geometry.setAttribute(name, attribute);
   }
-  usedBytes.set(storage, used * storage.BYTES_PER_ELEMENT);
-  attribute.clearUpdateRanges();
-  attribute.addUpdateRange(0, used);
-  attribute.needsUpdate = true;
   return attribute;
+}
+
+// One set of geometries for a model's three objects (surface, lines,
+// points; they share the position attribute). A model has two: the level on
+// screen is drawn from one while the next level goes to the GPU in the other.
+class GeometrySet {
+  constructor() {
+    this.geometries = [new BufferGeometry(), new BufferGeometry(), new BufferGeometry()];
+    this.queue = [];  // attributes with elements not yet marked for upload: { attribute, marked, used }
+  }
+
+  // Takes a level's arrays; their first `used` elements are to go to the GPU
+  // (see mark()).
+  stage(name, geometryIndex, storage, used, itemSize) {
+    const attribute = adoptAttribute(this.geometries[geometryIndex], name, storage, itemSize);
+    usedBytes.set(storage, 0);
+    if (used > 0) this.queue.push({ attribute, marked: 0, used });
+    return attribute;
+  }
+
+  get pending() {
+    return this.queue.length > 0;
+  }
+
+  // Marks up to `bytes` more of the staged elements for upload at the next
+  // render of the geometries.
+  mark(bytes) {
+    while (bytes > 0 && this.queue.length > 0) {
+      const item = this.queue[0];
+      const { attribute } = item;
+      const elementBytes = attribute.array.BYTES_PER_ELEMENT;
+      const count = Math.min(item.used - item.marked, Math.max(1, Math.floor(bytes / elementBytes)));
+      // A buffer three.js has yet to create gets its first elements from
+      // createBuffersFromUsedBytes, an existing one the update range.
+      usedBytes.set(attribute.array, (item.marked + count) * elementBytes);
+      attribute.clearUpdateRanges();  // earlier slices are on the GPU
+      attribute.addUpdateRange(item.marked, count);
+      attribute.needsUpdate = true;
+      item.marked += count;
+      bytes -= count * elementBytes;
+      if (item.marked === item.used) this.queue.shift();
+    }
+  }
+}
+
+// Uploads the next level of models in slices, between the page's frames,
+// on a renderer passed to prepareRenderer(). Under software WebGL in
+// Chromium an upload costs the page's main thread up to 4 ms per MB (the
+// dragon's last level holds 21 MB), and a level drawn before all of it
+// arrived would mix two levels' vertices and simplices. three.js uploads
+// the attributes of the objects it renders, so the slices ride on renders of
+// objects that draw nothing (an empty draw range, a trivial shader) into a
+// 1x1 target, which leave the canvas alone. A slice waits until the GPU has
+// finished all earlier work (a fence, polled without waiting), or the upload
+// would block the page until it had.
+class SlicedUploads {
+  constructor(renderer, camera, bytesPerSlice) {
+    this.renderer = renderer;
+    this.camera = camera;
+    this.bytesPerSlice = bytesPerSlice;
+    this.scene = new Scene();
+    this.target = new WebGLRenderTarget(1, 1, { depthBuffer: false });
+    this.material = new ShaderMaterial({
+      vertexShader: 'void main() { gl_Position = vec4(0.0); }',
+      fragmentShader: 'void main() { gl_FragColor = vec4(0.0); }',
+    });
+    this.fence = null;
+  }
+
+  // Objects that upload the geometries they are given (a model's three).
+  createUploaders() {
+    return [0, 1, 2].map(() => {
+      const object = new Mesh(new BufferGeometry(), this.material);
+      object.frustumCulled = false;
+      return object;
+    });
+  }
+
+  idle() {
+    if (!this.fence) return true;
+    const gl = this.renderer.getContext();
+    if (gl.clientWaitSync(this.fence, 0, 0) === gl.TIMEOUT_EXPIRED) return false;
+    gl.deleteSync(this.fence);
+    this.fence = null;
+    return true;
+  }
+
+  // Sends what is marked in the uploaders' geometries to the GPU.
+  run(uploaders) {
+    const { renderer } = this;
+    const gl = renderer.getContext();
+    for (const object of uploaders) object.geometry.setDrawRange(0, 0);
+    this.scene.add(...uploaders);
+    const target = renderer.getRenderTarget();
+    renderer.setRenderTarget(this.target);
+    renderer.render(this.scene, this.camera);
+    renderer.setRenderTarget(target);
+    this.scene.remove(...uploaders);
+    this.fence = gl.fenceSync(gl.SYNC_GPU_COMMANDS_COMPLETE, 0);
+    gl.flush();
+  }
+
+  dispose() {
+    this.target.dispose();
+    this.material.dispose();
+  }
 }
 
 // Buffers are sized for the final model from the first refinement on, but
 // writing a fresh GPU buffer is slow (under software WebGL in Chromium, 3 ms
-// per MB, against 0.2 ms per MB to rewrite one): the 21 MB of the dragon's
-// buffers would block the page for 60-360 ms. So on renderers passed to
+// per MB, against 0.2 ms per MB to rewrite one). So on renderers passed to
 // prepareRenderer(), a buffer created from one of these arrays receives only
-// the array's first `usedBytes` (the rest of a new WebGL buffer is zeros),
-// and later refinements touch the remainder a little at a time.
+// the array's first `usedBytes` (the rest of a new WebGL buffer is zeros);
+// the rest follows in slices (SlicedUploads).
 const usedBytes = new WeakMap();
 const preparedContexts = new WeakSet();
 function createBuffersFromUsedBytes(gl) {
@@ -76,6 +174,10 @@ export class KDMeshLoader extends Loader {
     this.wasmSource = undefined;
     this.workerUrl = new URL('./kdmesh-worker.js', import.meta.url);
     this.workers = new Set();
+    // Bytes of a level sent to the GPU at a time, on renderers passed to
+    // prepareRenderer() (see SlicedUploads).
+    this.uploadBytesPerSlice = 4 << 20;
+    this.uploads = null;
     this.materials = {
       surface: new MeshStandardMaterial({ color: 0xb8c4d6, roughness: 0.6, metalness: 0.05, side: DoubleSide }),
       lines: new LineBasicMaterial({ color: 0x33475b }),
@@ -91,11 +193,15 @@ export class KDMeshLoader extends Loader {
    *    draw of a model otherwise took 130-230 ms, even with the shaders
    *    compiled);
    *  - fills the GPU buffers of models as their content grows, not at once
-   *    (see createBuffersFromUsedBytes).
+   *    (see createBuffersFromUsedBytes), and uploads a level in slices of
+   *    `uploadBytesPerSlice` between frames, while the previous level stays
+   *    on screen (see SlicedUploads).
    * Call it before streaming starts.
    */
   async prepareRenderer(renderer, camera, scene) {
     createBuffersFromUsedBytes(renderer.getContext());
+    this.uploads?.dispose();
+    this.uploads = new SlicedUploads(renderer, camera, this.uploadBytesPerSlice);
     const sample = this.#createGroup();
     const behind = camera.localToWorld(new Vector3(0, 0, 1));
     const corners = new Float32BufferAttribute([...behind.toArray(), ...behind.toArray(), ...behind.toArray()], 3);
@@ -114,6 +220,10 @@ export class KDMeshLoader extends Loader {
       await renderer.compileAsync(sample, camera, scene);
       scene.add(sample);
       renderer.render(scene, camera);
+      // The uploads' shader, compiled now too.
+      const uploaders = this.uploads.createUploaders();
+      uploaders.forEach((object, i) => (object.geometry = sample.children[i].geometry));
+      this.uploads.run(uploaders);
     } finally {
       scene.remove(sample);
       for (const object of sample.children) object.geometry.dispose();
@@ -173,8 +283,7 @@ export class KDMeshLoader extends Loader {
    * 'wireframe' (the boundary plus every edge of the tetrahedra), geomorph
    * (true: new vertices glide from their parent's position over
    * geomorphFrames frames, default 12), onAnimate(model) whenever the model
-   * changes between refinements (geomorph frames; a level's vertices, which
-   * reach the GPU a frame before its simplices).
+   * changes between refinements (geomorph frames).
    */
   loadProgressive(url, options = {}) {
     const model = this.#start(options);
@@ -211,6 +320,8 @@ export class KDMeshLoader extends Loader {
       finished = true;
       worker.terminate();
       this.workers.delete(worker);
+      // The set not on screen holds an older level's GPU buffers.
+      for (const geometry of back.geometries) geometry.dispose();
       if (error) settle.reject(error);
       else settle.resolve(group);
     };
@@ -237,9 +348,19 @@ export class KDMeshLoader extends Loader {
       requestAnimationFrame(step);
     };
 
-    const applyVertices = (model) => {
+    // The level on screen is drawn from `front`; the next one is staged in
+    // `back` and, on prepared renderers, uploaded by `uploaders` in slices.
+    let front = new GeometrySet();
+    let back = new GeometrySet();
+    const uploads = this.uploads;
+    const uploaders = uploads?.createUploaders() ?? [];
+    const objects = group.children;
+    objects.forEach((object, i) => (object.geometry = front.geometries[i]));
+
+    let morphTarget = null;  // { start, positions, count } for a geomorph of the level staged
+    const stageVertices = (model) => {
       let drawn = storageOf(model.positions);
-      let start = null;
+      morphTarget = null;
       if (options.geomorph && previous) {
         drawn = new Float32Array(drawn.length);  // moves between the levels; model.positions stays
         for (let v = 0; v < model.vertexCount; ++v) {
@@ -249,55 +370,72 @@ export class KDMeshLoader extends Loader {
           drawn[3 * v + 1] = previous.positions[3 * ancestor + 1];
           drawn[3 * v + 2] = previous.positions[3 * ancestor + 2];
         }
-        start = drawn.slice(0, model.positions.length);
+        morphTarget = { start: drawn.slice(0, model.positions.length), positions: model.positions, count: model.vertexCount };
       }
       if (options.geomorph) previous = { positions: model.positions, count: model.vertexCount };
-      const position = adoptAttribute(surface.geometry, 'position', drawn, model.positions.length, 3);
-      lines.geometry.setAttribute('position', position);
-      points.geometry.setAttribute('position', position);
-      if (start) morph(position, start, model.positions, model.vertexCount);
-      else morphId += 1;  // a level drawn at once ends any morph in flight
+      const position = back.stage('position', 0, drawn, model.positions.length, 3);
+      back.geometries[1].setAttribute('position', position);
+      back.geometries[2].setAttribute('position', position);
       // Normals come from the worker. On the final dragon (871k triangles,
       // Node 20) the worker's loop takes 90 ms and three.js's
       // computeVertexNormals 140 ms, which would block the main thread.
-      if (model.normals.length) adoptAttribute(surface.geometry, 'normal', storageOf(model.normals), model.normals.length, 3);
+      if (model.normals.length) back.stage('normal', 0, storageOf(model.normals), model.normals.length, 3);
     };
-    const applyLists = (model) => {
-      // Lists drawn together lie one after the other in one storage (see the worker).
-      const lists = [
-        [surface, model.triangles, model.boundary.length],
-        [lines, model.edges, model.tetrahedronEdges.length],
-        [points, model.points, 0],
-      ];
+    // Lists drawn together lie one after the other in one storage (see the worker).
+    const listsOf = (model) => [
+      [model.triangles, model.boundary.length],
+      [model.edges, model.tetrahedronEdges.length],
+      [model.points, 0],
+    ];
+    const stageLists = (model) => {
       // One bounding volume from the current vertices (the worker's) serves
       // all three objects.
       const box = new Box3().setFromArray(model.bounds);
       const sphere = box.getBoundingSphere(new Sphere());
-      for (const [object, first, more] of lists) {
+      listsOf(model).forEach(([first, more], i) => {
         const count = first.length + more;
-        if (count) adoptAttribute(object.geometry, 'index', storageOf(first), count, 1);
-        object.geometry.setDrawRange(0, count);
-        object.geometry.boundingBox = box.clone();
-        object.geometry.boundingSphere = sphere.clone();
-        object.visible = count > 0;
-      }
+        if (count) back.stage('index', i, storageOf(first), count, 1);
+        const geometry = back.geometries[i];
+        geometry.boundingBox = box.clone();
+        geometry.boundingSphere = sphere.clone();
+      });
+    };
+    // The staged level goes on screen; the set it replaces takes the next.
+    const swap = (model) => {
+      [front, back] = [back, front];
+      listsOf(model).forEach(([first, more], i) => {
+        const count = first.length + more;
+        front.geometries[i].setDrawRange(0, count);
+        objects[i].geometry = front.geometries[i];
+        objects[i].visible = count > 0;
+      });
+      const position = front.geometries[0].getAttribute('position');
+      if (morphTarget) morph(position, morphTarget.start, morphTarget.positions, morphTarget.count);
+      else morphId += 1;  // a level drawn at once ends any morph in flight
     };
 
     // A snapshot waits for the next frame; an error that arrives meanwhile
     // is reported after it is drawn, so the last good level stays on screen.
     let drawing = Promise.resolve();
-    // The vertices and the lists of a level reach the GPU in separate
-    // frames, which halves the largest upload of a frame; meanwhile the
-    // previous level's lists are drawn over the new positions (vertices keep
-    // their ids, and new ones are not yet referenced).
     const draw = async (model) => {
       await nextFrame();  // at most one geometry update per frame
       if (finished) return;
-      applyVertices(model);
-      options.onAnimate?.(group);
-      await nextFrame();
-      if (finished) return;
-      applyLists(model);
+      stageVertices(model);
+      stageLists(model);
+      if (uploads) {
+        uploaders.forEach((object, i) => (object.geometry = back.geometries[i]));
+        while (back.pending) {
+          if (uploads.idle()) {
+            back.mark(uploads.bytesPerSlice);
+            uploads.run(uploaders);
+          }
+          await nextFrame();
+          if (finished) return;
+        }
+      } else {
+        back.mark(Infinity);  // uploaded when first drawn
+      }
+      swap(model);
       stats.refinements += 1;
       stats.complete = model.complete;
       stats.model = model;
@@ -341,6 +479,7 @@ export class KDMeshLoader extends Loader {
 
   /** Stops every decoding worker and frees the materials. */
   dispose() {
+    this.uploads?.dispose();
     for (const worker of this.workers) worker.terminate();
     this.workers.clear();
     for (const material of Object.values(this.materials)) material.dispose();

@@ -9,12 +9,18 @@ import { modelChecksum } from './model-checksum.js';
 const $ = (id) => document.getElementById(id);
 const viewer = (window.kdmeshViewer = {
   state: 'idle', refinements: 0, vertexCount: 0, triangleCount: 0, tetrahedronCount: 0, edgeCount: 0,
-  pointCount: 0, bytesReceived: 0, bytesExpected: 0, level: 0, error: null, checksum: null, firstRenderMs: null,
+  pointCount: 0, bytesReceived: 0, bytesExpected: 0, level: 0, error: null, firstRenderMs: null,
   // Since the load began: the first and the last level drawn, and the last
   // level decoded.
   completeMs: null, finalRenderMs: null, levelsSeen: [], longTasks: [],
   // Decoding workers still running (0 once a load has ended, however).
   activeWorkers: () => loader.workers.size,
+  // Of the complete model, for tests to compare with a Node decode. Computed
+  // when read: hashing the dragon's arrays takes ~60 ms, a long task the
+  // page itself has no use for.
+  get checksum() {
+    return this.state === 'complete' ? modelChecksum(current.userData.stats.model) : null;
+  },
   // Whether the drawn positions are the last level's exactly (for tests:
   // geomorphs must end where the model is).
   drawnPositionsMatch() {
@@ -24,19 +30,31 @@ const viewer = (window.kdmeshViewer = {
     for (let i = 0; i < model.positions.length; ++i) if (drawn[i] !== model.positions[i]) return false;
     return true;
   },
-  // Pixels of the last frame that differ from the background (for tests).
+  // Pixels of a new frame that differ from the background (for tests).
   modelPixels() {
-    renderer.render(scene, camera);
-    const canvas = document.createElement('canvas');
-    canvas.width = renderer.domElement.width;
-    canvas.height = renderer.domElement.height;
-    const context = canvas.getContext('2d');
-    context.drawImage(renderer.domElement, 0, 0);
-    const { data } = context.getImageData(0, 0, canvas.width, canvas.height);
+    const data = framePixels();
     const [r, g, b] = [0xf4, 0xf6, 0xf8];
     let count = 0;
     for (let i = 0; i < data.length; i += 4)
       if (Math.abs(data[i] - r) + Math.abs(data[i + 1] - g) + Math.abs(data[i + 2] - b) > 24) ++count;
+    return count;
+  },
+  // Pixels that differ between a frame of the model as streamed and one of
+  // copies of its geometries uploaded whole (for tests: 0 when every slice
+  // of every level reached the GPU).
+  pixelsDifferingFromFreshUpload() {
+    const streamed = framePixels();
+    const objects = current.children;
+    const geometries = objects.map((object) => object.geometry);
+    objects.forEach((object) => (object.geometry = object.geometry.clone()));
+    const fresh = framePixels();
+    objects.forEach((object, i) => {
+      object.geometry.dispose();
+      object.geometry = geometries[i];
+    });
+    let count = 0;
+    for (let i = 0; i < streamed.length; i += 4)
+      if (streamed[i] !== fresh[i] || streamed[i + 1] !== fresh[i + 1] || streamed[i + 2] !== fresh[i + 2]) ++count;
     return count;
   },
 });
@@ -49,6 +67,16 @@ if (typeof PerformanceObserver === 'function' && PerformanceObserver.supportedEn
     for (const entry of list.getEntries())
       if (entry.startTime >= loadBegan) viewer.longTasks.push(Math.round(entry.duration));
   }).observe({ type: 'longtask' });
+}
+
+function framePixels() {
+  renderer.render(scene, camera);
+  const canvas = document.createElement('canvas');
+  canvas.width = renderer.domElement.width;
+  canvas.height = renderer.domElement.height;
+  const context = canvas.getContext('2d');
+  context.drawImage(renderer.domElement, 0, 0);
+  return context.getImageData(0, 0, canvas.width, canvas.height).data;
 }
 
 const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
@@ -150,7 +178,7 @@ function start(load) {
   controller = new AbortController();
   framed = false;
   const began = (loadBegan = performance.now());
-  Object.assign(viewer, { state: 'loading', refinements: 0, error: null, checksum: null, firstRenderMs: null, completeMs: null, finalRenderMs: null, bytesReceived: 0, levelsSeen: [], longTasks: [] });
+  Object.assign(viewer, { state: 'loading', refinements: 0, error: null, firstRenderMs: null, completeMs: null, finalRenderMs: null, bytesReceived: 0, levelsSeen: [], longTasks: [] });
   showStatus('loading…');
   const options = {
     signal: controller.signal,
@@ -172,7 +200,6 @@ function start(load) {
       if (!viewer.levelsSeen.includes(m.progress.level)) viewer.levelsSeen.push(m.progress.level);
       if (!framed) { frame(group); framed = true; }
       if (m.complete) {
-        viewer.checksum = modelChecksum(m);
         viewer.completeMs = performance.now() - began;
         viewer.state = 'complete';
         $('progress').value = 1;

@@ -61,6 +61,7 @@ test('the dragon streams through a throttled route, refines at least 5 times and
   assert.ok(early > 500, `mid-stream model pixels: ${early}`);
   assert.ok(final > 5000, `final model pixels: ${final}`);
   assert.notEqual(final, early);
+  assert.equal(await page.evaluate(() => window.kdmeshViewer.pixelsDifferingFromFreshUpload()), 0);
 
   const expected = await decode(readFileSync(join(models, 'dragon.kdm')));
   assert.equal(state.vertexCount, expected.vertexCount);
