@@ -230,5 +230,16 @@ TEST(Stream, ChunkFramesClaimingMoreSplitsThanTheirBytesCanCodeAreRefused) {
   EXPECT_EQ(d.push(bytes.data(), kHeaderBytes + kChunkFrameBytes).code, ErrorCode::CorruptChunk);
 }
 
+// Streams decode alike everywhere only if the encoder and every decoder
+// round each floating-point operation alike: the build must not fuse a
+// multiply and an add (CMakeLists.txt), as GCC does by default for targets
+// with FMA. Here x*y is 1 - 2^-60 exactly, 1 once rounded; fused, the sum
+// keeps the -2^-60.
+TEST(Stream, BuildRoundsMultiplyAndAddSeparately) {
+  volatile double loaded[3] = {1.0 + 0x1p-30, 1.0 - 0x1p-30, -1.0};
+  const double x = loaded[0], y = loaded[1], z = loaded[2];
+  EXPECT_EQ(x * y + z, 0.0);
+}
+
 }  // namespace
 }  // namespace kdmesh::test
