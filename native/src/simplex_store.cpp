@@ -12,13 +12,6 @@ void sortSmall(uint32_t* v, int n) {
 
 }  // namespace
 
-int tupleParity(const uint32_t* v, int n) {
-  int inversions = 0;
-  for (int i = 0; i < n; ++i)
-    for (int j = i + 1; j < n; ++j) inversions += v[i] > v[j];
-  return inversions & 1;
-}
-
 void SimplexStore::reset(uint32_t vertexCapacity, bool indexed) {
   indexed_ = indexed;
   for (int d = 1; d <= kMaxDimension; ++d) {
@@ -139,11 +132,6 @@ void SimplexStore::replaceVertex(int dimension, uint32_t simplex, uint32_t from,
   uint32_t* v = &pool_[dimension].vertices[size_t(simplex) * size_t(dimension + 1)];
   *std::find(v, v + dimension + 1, from) = to;
   if (indexed_) insertIndex(dimension, simplex);
-}
-
-int SimplexStore::parity(int dimension, uint32_t simplex) const {
-  return tupleParity(vertices(dimension, simplex), dimension + 1) ^
-         ((flags(dimension, simplex) & kFlipped) ? 1 : 0);
 }
 
 bool SimplexStore::hasIncident(int dimension, uint32_t vertex) const {

@@ -22,7 +22,12 @@ constexpr uint32_t kNoSimplex = 0xffffffffu;
 
 // Parity of the permutation that sorts the n vertex ids v[0..n) ascending:
 // 0 even, 1 odd.
-int tupleParity(const uint32_t* v, int n);
+inline int tupleParity(const uint32_t* v, int n) {
+  int inversions = 0;
+  for (int i = 0; i < n; ++i)
+    for (int j = i + 1; j < n; ++j) inversions += v[i] > v[j];
+  return inversions & 1;
+}
 
 class SimplexStore {
  public:
@@ -69,7 +74,9 @@ class SimplexStore {
 
   // Orientation as the parity of the oriented tuple relative to the
   // ascending order of its vertex ids (0 even, 1 odd).
-  int parity(int dimension, uint32_t simplex) const;
+  int parity(int dimension, uint32_t simplex) const {
+    return tupleParity(vertices(dimension, simplex), dimension + 1) ^ ((flags(dimension, simplex) & kFlipped) ? 1 : 0);
+  }
 
   // Calls visit(simplex, position) for every live simplex of `dimension`
   // holding `vertex`, unlinking killed ones on the way.

@@ -11,8 +11,12 @@ bool lessOthers(const uint32_t* a, const uint32_t* b, int count) {
   return false;
 }
 
+// A plain loop: std::find over at most four ids was an out-of-line call in
+// the orientation vote, the decoder's third hottest loop.
 bool containsVertex(const uint32_t* vertices, int arity, uint32_t vertex) {
-  return std::find(vertices, vertices + arity, vertex) != vertices + arity;
+  bool found = false;
+  for (int i = 0; i < arity; ++i) found |= vertices[i] == vertex;
+  return found;
 }
 
 // Number of vertices of the simplex with a smaller id than `vertex`: the
@@ -68,6 +72,10 @@ uint8_t VertexSplitter::possibleCodes(const Entry& entry) const {
   const int d = entry.dimension;
   if (d == 0) return 0b1100;
   uint8_t possible = d == SimplexStore::kMaxDimension ? 0b0111 : 0b1111;
+  if (d == 2) {  // linkFans found the two edges through v, or left a mark
+    if (entry.links[0] == kNoSimplex) return 0;
+    return possible & kAllowedBy[star_[entry.links[0]].code] & kAllowedBy[star_[entry.links[1]].code];
+  }
   // Every face of the simplex through v: drop one of the other vertices.
   for (int skip = 0; skip < d; ++skip) {
     uint32_t faceOthers[3];
