@@ -26,9 +26,17 @@
 
 #include <algorithm>
 #include <array>
+#include <cfloat>
 #include <cmath>
 #include <cstdint>
 #include <vector>
+
+// Encoder and decoders must round every double operation alike (see
+// docs/FORMAT.md): not in x87 extended precision, as 32-bit x86 does unless
+// told otherwise.
+#if defined(FLT_EVAL_METHOD) && FLT_EVAL_METHOD != 0
+#error "kdmesh needs double arithmetic evaluated in double precision (on 32-bit x86: -msse2 -mfpmath=sse)"
+#endif
 
 #include "count_coder.h"
 #include "kdmesh/kdmesh.h"
