@@ -17,34 +17,34 @@ namespace kdmesh {
 // Probabilities in 12 bits, logistic values in [-2047, 2047] (units of 1/256).
 class Logistic {
  public:
-  static int squash(int d) {
+  static constexpr int squash(int d) {
     if (d > 2047) d = 2047;
     if (d < -2047) d = -2047;
     // 4096 / (1 + e^(-d/256)) at d = -2048, -1920, ..., 2048, rounded.
-    static constexpr int kKnots[33] = {1,    2,    4,    6,    10,   17,   27,   45,   74,   120,  194,
-                                       311,  488,  747,  1102, 1546, 2048, 2550, 2994, 3349, 3608, 3785,
-                                       3902, 3976, 4022, 4051, 4069, 4079, 4086, 4090, 4092, 4094, 4095};
+    constexpr int kKnots[33] = {1,    2,    4,    6,    10,   17,   27,   45,   74,   120,  194,
+                                311,  488,  747,  1102, 1546, 2048, 2550, 2994, 3349, 3608, 3785,
+                                3902, 3976, 4022, 4051, 4069, 4079, 4086, 4090, 4092, 4094, 4095};
     const int i = (d + 2048) >> 7, w = (d + 2048) & 127;
     return (kKnots[i] * (128 - w) + kKnots[i + 1] * w + 64) >> 7;
   }
-  static int stretch(int p) { return table().stretch[size_t(p)]; }
+  static int stretch(int p);
+};
 
- private:
-  struct Table {
-    std::array<int16_t, 4096> stretch;
-    // The inverse of squash: for each p, the smallest d with squash(d) >= p.
-    Table() {
-      int p = 0;
-      for (int d = -2047; d <= 2047; ++d)
-        for (const int s = squash(d); p <= s && p < 4096; ++p) stretch[size_t(p)] = int16_t(d);
-      for (; p < 4096; ++p) stretch[size_t(p)] = 2047;
-    }
-  };
-  static const Table& table() {
-    static const Table t;
-    return t;
+// The inverse of squash: for each p, the smallest d with squash(d) >= p.
+// Built by the compiler: a table made on first use cost a guard test on
+// every call.
+struct StretchTable {
+  std::array<int16_t, 4096> values{};
+  constexpr StretchTable() {
+    int p = 0;
+    for (int d = -2047; d <= 2047; ++d)
+      for (const int s = Logistic::squash(d); p <= s && p < 4096; ++p) values[size_t(p)] = int16_t(d);
+    for (; p < 4096; ++p) values[size_t(p)] = 2047;
   }
 };
+inline constexpr StretchTable kStretchTable{};
+
+inline int Logistic::stretch(int p) { return kStretchTable.values[size_t(p)]; }
 
 // Mixes kInputs models with one of `sets` weight vectors, which start at
 // `initial` (in units of 2^-16).

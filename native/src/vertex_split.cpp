@@ -192,39 +192,45 @@ const std::vector<uint32_t>& VertexSplitter::around(int dimension) {
   return list;
 }
 
-int VertexSplitter::predictFlip(int dimension, uint32_t simplex, int& voteClass) {
-  const int arity = dimension + 1;
-  const uint32_t* mine = store_.vertices(dimension, simplex);
-  const int myParity = store_.parity(dimension, simplex);
+// The vote of predictFlip for simplices of kArity vertices, the arity known
+// at compile time so that the comparisons unroll without branches.
+template <int kArity>
+int VertexSplitter::voteOnFlip(uint32_t simplex, const std::vector<uint32_t>& candidates, int& voteClass) const {
+  constexpr int kDimension = kArity - 1;
+  const uint32_t* mine = store_.vertices(kDimension, simplex);
+  const int myParity = store_.parity(kDimension, simplex);
   int keep = 0, flip = 0;
-  auto consider = [&](uint32_t other) {
-    if (other == simplex || (store_.flags(dimension, other) & SimplexStore::kUndecided)) return;
-    const uint32_t* theirs = store_.vertices(dimension, other);
-    // They are neighbours when they share all vertices but one each; most
-    // candidates miss two vertices early.
-    uint32_t mineOnly = 0, theirsOnly = 0;
-    int missing = 0;
-    for (int i = 0; i < arity; ++i) {
-      if (containsVertex(theirs, arity, mine[i])) continue;
-      if (++missing > 1) return;
-      mineOnly = mine[i];
+  for (const uint32_t other : candidates) {
+    if (other == simplex || (store_.flags(kDimension, other) & SimplexStore::kUndecided)) continue;
+    const uint32_t* theirs = store_.vertices(kDimension, other);
+    // Neighbours share all vertices but one each.
+    int mineShared = 0, theirsShared = 0;  // bit i: vertex i is in the other
+    for (int i = 0; i < kArity; ++i) {
+      mineShared |= int(containsVertex(theirs, kArity, mine[i])) << i;
+      theirsShared |= int(containsVertex(mine, kArity, theirs[i])) << i;
     }
-    if (missing != 1) return;
-    for (int i = 0; i < arity; ++i)
-      if (!containsVertex(mine, arity, theirs[i])) theirsOnly = theirs[i];
+    constexpr int kAll = (1 << kArity) - 1;
+    const int mineOnly = kAll ^ mineShared;
+    if (mineOnly & (mineOnly - 1) || mineOnly == 0) continue;  // not exactly one vertex apart
+    const int theirsOnly = kAll ^ theirsShared;
     // Orientation each induces on the shared facet; consistent neighbours
     // induce opposite ones.
-    const int mySign = myParity ^ (rankOf(mine, arity, mineOnly) & 1);
+    const int mySign = myParity ^ (rankOf(mine, kArity, mine[__builtin_ctz(unsigned(mineOnly))]) & 1);
     const int theirSign =
-        store_.parity(dimension, other) ^ (rankOf(theirs, arity, theirsOnly) & 1);
+        store_.parity(kDimension, other) ^ (rankOf(theirs, kArity, theirs[__builtin_ctz(unsigned(theirsOnly))]) & 1);
     if (mySign == theirSign)
       ++flip;
     else
       ++keep;
-  };
-  for (const uint32_t other : around(dimension)) consider(other);
+  }
   voteClass = keep + flip == 0 ? 0 : (keep == 0 || flip == 0) ? 1 : 2;
   return flip > keep;
+}
+
+int VertexSplitter::predictFlip(int dimension, uint32_t simplex, int& voteClass) {
+  const std::vector<uint32_t>& candidates = around(dimension);
+  return dimension == 2 ? voteOnFlip<3>(simplex, candidates, voteClass)
+                        : voteOnFlip<4>(simplex, candidates, voteClass);
 }
 
 }  // namespace kdmesh

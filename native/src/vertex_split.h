@@ -118,6 +118,8 @@ class VertexSplitter {
   template <class Coder>
   void decideOrientation(Coder& coder, int dimension, uint32_t simplex, bool isCopy, uint8_t target);
   int predictFlip(int dimension, uint32_t simplex, int& voteClass);
+  template <int kArity>
+  int voteOnFlip(uint32_t simplex, const std::vector<uint32_t>& candidates, int& voteClass) const;
 
   SimplexStore& store_;
   const PositionPredictor& geometry_;
