@@ -12,25 +12,40 @@ constexpr int kTiltClasses = 5;  // the last: no plane
 constexpr int kPlaneBuckets = 6;
 constexpr int kCentroidBuckets = 10;
 
+// How many of the ascending `bounds` are at most t: a class without
+// branches (the features fall on either side of a bound at random, which
+// the branch predictor cannot learn). NaN falls in class 0.
+template <size_t kCount>
+int countAtMost(double t, const double (&bounds)[kCount]) {
+  int below = 0;
+  for (const double bound : bounds) below += t >= bound;
+  return below;
+}
+
 // The root mean square neighbour distance in half widths of the cell, from
 // its square.
-int scaleClass(double r) { return r < 4 ? 0 : r < 16 ? 1 : r < 64 ? 2 : r < 256 ? 3 : 4; }
+int scaleClass(double r) {
+  static constexpr double kBounds[kScaleClasses - 1] = {4, 16, 64, 256};
+  return countAtMost(r, kBounds);
+}
 
 // The plane's rise across the cell along the other axes, against its rise
 // along the split axis.
-int tiltClass(double tilt) { return tilt < 0.3 ? 0 : tilt < 1 ? 1 : tilt < 3 ? 2 : 3; }
+int tiltClass(double tilt) {
+  static constexpr double kBounds[kTiltClasses - 2] = {0.3, 1, 3};
+  return countAtMost(tilt, kBounds);
+}
 
 // Offsets from the split plane in half widths; the plane's is >= 0 after
 // mirroring, the centroid's may have either sign.
 int planeBucket(double t) {
-  return t < 0.25 ? 0 : t < 0.5 ? 1 : t < 1 ? 2 : t < 2 ? 3 : t < 4 ? 4 : 5;
+  static constexpr double kBounds[kPlaneBuckets - 1] = {0.25, 0.5, 1, 2, 4};
+  return countAtMost(t, kBounds);
 }
 
 int centroidBucket(double t) {
   static constexpr double kBounds[kCentroidBuckets - 1] = {-2, -1, -0.5, -0.25, 0, 0.25, 0.5, 1, 2};
-  int bucket = 0;
-  while (bucket < kCentroidBuckets - 1 && t >= kBounds[bucket]) ++bucket;
-  return bucket;
+  return countAtMost(t, kBounds);
 }
 
 }  // namespace
