@@ -57,15 +57,26 @@ void gatherStar(SimplexStore& store, uint32_t v, std::vector<StarEntry>& star,
   begin[4] = star.size();
 }
 
+// The sort key of a face's other vertices (faces have one or two), the
+// order of lessOthers.
+static uint64_t faceKey(const uint32_t* others, int dimension) {
+  return dimension == 1 ? others[0] : uint64_t(others[0]) << 32 | others[1];
+}
+
+// A binary search whose steps are conditional moves, not branches: which
+// half holds the face is a coin toss for the branch predictor.
 const VertexSplitter::Entry* VertexSplitter::findFace(int dimension, const uint32_t* others) const {
   if (dimension == 0) return &star_[0];
-  const auto first = star_.begin() + std::ptrdiff_t(begin_[size_t(dimension)]);
-  const auto last = star_.begin() + std::ptrdiff_t(begin_[size_t(dimension) + 1]);
-  const auto at = std::lower_bound(first, last, others, [dimension](const Entry& e, const uint32_t* o) {
-    return lessOthers(e.others, o, dimension);
-  });
-  if (at == last || lessOthers(others, at->others, dimension)) return nullptr;
-  return &*at;
+  const Entry* base = star_.data() + begin_[size_t(dimension)];
+  size_t count = begin_[size_t(dimension) + 1] - begin_[size_t(dimension)];
+  if (count == 0) return nullptr;
+  const uint64_t key = faceKey(others, dimension);
+  while (count > 1) {  // the face, if present, is in base[0..count)
+    const size_t half = count / 2;
+    base = faceKey(base[half].others, dimension) <= key ? base + half : base;
+    count -= half;
+  }
+  return faceKey(base->others, dimension) == key ? base : nullptr;
 }
 
 uint8_t VertexSplitter::possibleCodes(const Entry& entry) const {
