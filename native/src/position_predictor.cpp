@@ -12,16 +12,6 @@ constexpr int kTiltClasses = 5;  // the last: no plane
 constexpr int kPlaneBuckets = 6;
 constexpr int kCentroidBuckets = 10;
 
-// How many of the ascending `bounds` are at most t: a class without
-// branches (the features fall on either side of a bound at random, which
-// the branch predictor cannot learn). NaN falls in class 0.
-template <size_t kCount>
-int countAtMost(double t, const double (&bounds)[kCount]) {
-  int below = 0;
-  for (const double bound : bounds) below += t >= bound;
-  return below;
-}
-
 // The root mean square neighbour distance in half widths of the cell, from
 // its square.
 int scaleClass(double r) {

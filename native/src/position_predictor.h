@@ -47,6 +47,16 @@
 
 namespace kdmesh {
 
+// How many of the ascending `bounds` are at most t: the class of a feature
+// without branches (features fall on either side of a bound at random, which
+// a branch predictor cannot learn). NaN falls in class 0.
+template <size_t kCount>
+int countAtMost(double t, const double (&bounds)[kCount]) {
+  int below = 0;
+  for (const double bound : bounds) below += t >= bound;
+  return below;
+}
+
 class PositionPredictor {
  public:
   explicit PositionPredictor(const SplitSchedule& schedule);

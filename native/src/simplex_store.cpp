@@ -130,7 +130,7 @@ void SimplexStore::kill(int dimension, uint32_t simplex) {
 void SimplexStore::replaceVertex(int dimension, uint32_t simplex, uint32_t from, uint32_t to) {
   if (indexed_) eraseIndex(dimension, simplex);
   uint32_t* v = &pool_[dimension].vertices[size_t(simplex) * size_t(dimension + 1)];
-  *std::find(v, v + dimension + 1, from) = to;
+  for (int i = 0; i <= dimension; ++i) v[i] = v[i] == from ? to : v[i];  // no branch to mispredict
   if (indexed_) insertIndex(dimension, simplex);
 }
 

@@ -129,7 +129,8 @@ void VertexSplitter::classifyEdges(uint32_t v, int level) {
   }
   for (size_t i = first; i < last; ++i) {
     const double cosine = cosines_[i - first], magnitude = std::fabs(cosine);
-    const int bucket = magnitude < 0.2 ? 0 : magnitude < 0.45 ? 1 : magnitude < 0.7 ? 2 : 3;
+    static constexpr double kBounds[3] = {0.2, 0.45, 0.7};
+    const int bucket = countAtMost(magnitude, kBounds);
     // Between a fan neighbour on v's side and one on v2's side lies a cut
     // edge: likely the one of the two closer to the split plane.
     int crossing = 0;
@@ -178,7 +179,8 @@ void VertexSplitter::linkFans() {
 int VertexSplitter::triangleClass(const Entry& triangle) const {
   const double ca = cosines_[triangle.links[0] - begin_[1]];
   const double cb = cosines_[triangle.links[1] - begin_[1]];
-  auto bucket = [](double c) { return std::fabs(c) < 0.2 ? 0 : std::fabs(c) < 0.45 ? 1 : 2; };
+  static constexpr double kBounds[2] = {0.2, 0.45};
+  auto bucket = [](double c) { return countAtMost(std::fabs(c), kBounds); };
   const int low = std::min(bucket(ca), bucket(cb)), high = std::max(bucket(ca), bucket(cb));
   return ((ca > 0) == (cb > 0)) * 9 + low * 3 + high;
 }
