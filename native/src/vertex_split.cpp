@@ -27,6 +27,36 @@ int rankOf(const uint32_t* vertices, int arity, uint32_t vertex) {
   return rank;
 }
 
+// The sort key of a simplex's other vertices when it has one or two (the
+// order of lessOthers).
+uint64_t othersKey(const uint32_t* others, int count) {
+  return count == 1 ? others[0] : uint64_t(others[0]) << 32 | others[1];
+}
+
+// Sorts star[first, last), the entries of dimension d, by their other
+// vertices. A star's lists are short and arrive in no useful order: placing
+// each entry at its rank (how many keys are smaller, counted over a fixed
+// eight so that the count's loop always runs alike) takes no branch on the
+// keys, where a comparison sort mispredicts about once per entry.
+void sortByOthers(std::vector<StarEntry>& star, size_t first, size_t last, int d) {
+  constexpr size_t kRanked = 8;
+  const size_t n = last - first;
+  if (d > 2 || n > kRanked) {
+    std::sort(star.begin() + std::ptrdiff_t(first), star.begin() + std::ptrdiff_t(last),
+              [d](const StarEntry& a, const StarEntry& b) { return lessOthers(a.others, b.others, d); });
+    return;
+  }
+  uint64_t keys[kRanked];
+  for (size_t i = 0; i < kRanked; ++i) keys[i] = i < n ? othersKey(star[first + i].others, d) : ~uint64_t(0);
+  StarEntry ranked[kRanked];
+  for (size_t i = 0; i < n; ++i) {
+    size_t rank = 0;
+    for (size_t j = 0; j < kRanked; ++j) rank += keys[j] < keys[i];
+    ranked[rank] = star[first + i];
+  }
+  std::copy(ranked, ranked + n, star.begin() + std::ptrdiff_t(first));
+}
+
 }  // namespace
 
 void gatherStar(SimplexStore& store, uint32_t v, std::vector<StarEntry>& star,
@@ -46,21 +76,22 @@ void gatherStar(SimplexStore& store, uint32_t v, std::vector<StarEntry>& star,
       int n = 0;
       for (int i = 0; i <= d; ++i)
         if (i != int(position)) entry.others[n++] = vertices[i];
-      for (int i = 1; i < n; ++i)  // at most three: insertion sort
-        for (int j = i; j > 0 && entry.others[j - 1] > entry.others[j]; --j)
-          std::swap(entry.others[j - 1], entry.others[j]);
+      // At most three: a sorting network of minima and maxima (no branches).
+      auto order = [&entry](int i, int j) {
+        const uint32_t low = std::min(entry.others[i], entry.others[j]);
+        entry.others[j] = std::max(entry.others[i], entry.others[j]);
+        entry.others[i] = low;
+      };
+      if (n >= 2) order(0, 1);
+      if (n == 3) {
+        order(1, 2);
+        order(0, 1);
+      }
       star.push_back(entry);
     });
-    std::sort(star.begin() + std::ptrdiff_t(begin[size_t(d)]), star.end(),
-              [d](const StarEntry& a, const StarEntry& b) { return lessOthers(a.others, b.others, d); });
+    sortByOthers(star, begin[size_t(d)], star.size(), d);
   }
   begin[4] = star.size();
-}
-
-// The sort key of a face's other vertices (faces have one or two), the
-// order of lessOthers.
-static uint64_t faceKey(const uint32_t* others, int dimension) {
-  return dimension == 1 ? others[0] : uint64_t(others[0]) << 32 | others[1];
 }
 
 // A binary search whose steps are conditional moves, not branches: which
@@ -70,13 +101,13 @@ const VertexSplitter::Entry* VertexSplitter::findFace(int dimension, const uint3
   const Entry* base = star_.data() + begin_[size_t(dimension)];
   size_t count = begin_[size_t(dimension) + 1] - begin_[size_t(dimension)];
   if (count == 0) return nullptr;
-  const uint64_t key = faceKey(others, dimension);
+  const uint64_t key = othersKey(others, dimension);
   while (count > 1) {  // the face, if present, is in base[0..count)
     const size_t half = count / 2;
-    base = faceKey(base[half].others, dimension) <= key ? base + half : base;
+    base = othersKey(base[half].others, dimension) <= key ? base + half : base;
     count -= half;
   }
-  return faceKey(base->others, dimension) == key ? base : nullptr;
+  return othersKey(base->others, dimension) == key ? base : nullptr;
 }
 
 uint8_t VertexSplitter::possibleCodes(const Entry& entry) const {
