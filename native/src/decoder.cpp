@@ -290,6 +290,56 @@ struct Decoder::State {
     for (const Cell& c : newSingles) visit(c, level + 1);
   }
 
+  // Cells of the current level; once complete, the vertices.
+  uint32_t cellCount() const {
+    if (complete()) return header.vertexCount;
+    return uint32_t(children.size() + cells.size() - cursor + singles.size() + newSingles.size());
+  }
+
+  // Replaces `out` with the model at the current level (Decoder::snapshot);
+  // once complete, `takeFinal` moves the simplex lists out instead of
+  // copying them, for decode(), whose decoder is discarded next (the copy
+  // was 12 bytes per triangle of peak memory).
+  void snapshot(Complex& out, bool takeFinal) {
+    out = Complex{};
+    if (!hasHeader) return;
+    const bool finished = complete();
+    if (connectivity) {
+      out.positions.resize(size_t(nextVertex) * 3);
+      forEachCurrentCell([&](const Cell& cell, int cellLevel) {
+        for (int a = 0; a < 3; ++a) {
+          uint32_t lo, hi;
+          cellRange(cell, cellLevel, a, lo, hi);
+          out.positions[size_t(cell.vertex) * 3 + size_t(a)] = dequantizer->position(a, lo, hi);
+        }
+      });
+      if (!finished) {
+        appendSimplices(out);
+        return;
+      }
+      std::vector<uint32_t>* from[4] = {&finalComplex.points, &finalComplex.edges, &finalComplex.triangles,
+                                        &finalComplex.tetrahedra};
+      std::vector<uint32_t>* to[4] = {&out.points, &out.edges, &out.triangles, &out.tetrahedra};
+      for (int i = 0; i < 4; ++i) *to[i] = takeFinal ? std::move(*from[i]) : *from[i];
+      return;
+    }
+    out.positions.reserve(size_t(cellCount()) * 3);
+    forEachCurrentCell([&](const Cell& cell, int cellLevel) {
+      float position[3];
+      for (int a = 0; a < 3; ++a) {
+        uint32_t lo, hi;
+        cellRange(cell, cellLevel, a, lo, hi);
+        position[a] = dequantizer->position(a, lo, hi);
+      }
+      // A finished cell holds coincident vertices; before that it is one vertex.
+      const uint32_t copies = finished ? cell.population : 1;
+      for (uint32_t i = 0; i < copies; ++i) out.positions.insert(out.positions.end(), position, position + 3);
+    });
+    const uint32_t n = uint32_t(out.vertexCount());
+    out.points.resize(n);
+    for (uint32_t i = 0; i < n; ++i) out.points[i] = i;
+  }
+
   // Applies the header and every whole chunk at the start of `data`; returns
   // in `offset` how many bytes that used.
   Status process(const uint8_t* data, size_t size, size_t& offset) {
@@ -393,53 +443,11 @@ DecodeProgress Decoder::progress() const {
   p.chunksApplied = uint32_t(s.chunks.size());
   p.level = uint32_t(s.level);
   p.complete = s.complete();
-  if (s.hasHeader)
-    p.cellCount = uint32_t(p.complete ? s.header.vertexCount
-                                      : s.children.size() + s.cells.size() - s.cursor + s.singles.size() +
-                                                  s.newSingles.size());
+  if (s.hasHeader) p.cellCount = s.cellCount();
   return p;
 }
 
-void Decoder::snapshot(Complex& out) const {
-  const State& s = *state_;
-  out = Complex{};
-  if (!s.hasHeader) return;
-  if (s.connectivity) {
-    out.positions.resize(size_t(s.nextVertex) * 3);
-    s.forEachCurrentCell([&](const Cell& cell, int cellLevel) {
-      for (int a = 0; a < 3; ++a) {
-        uint32_t lo, hi;
-        s.cellRange(cell, cellLevel, a, lo, hi);
-        out.positions[size_t(cell.vertex) * 3 + size_t(a)] = s.dequantizer->position(a, lo, hi);
-      }
-    });
-    if (s.complete()) {
-      out.points = s.finalComplex.points;
-      out.edges = s.finalComplex.edges;
-      out.triangles = s.finalComplex.triangles;
-      out.tetrahedra = s.finalComplex.tetrahedra;
-    } else {
-      s.appendSimplices(out);
-    }
-    return;
-  }
-  const bool complete = s.complete();
-  out.positions.reserve(size_t(complete ? s.header.vertexCount : progress().cellCount) * 3);
-  s.forEachCurrentCell([&](const Cell& cell, int cellLevel) {
-    float position[3];
-    for (int a = 0; a < 3; ++a) {
-      uint32_t lo, hi;
-      s.cellRange(cell, cellLevel, a, lo, hi);
-      position[a] = s.dequantizer->position(a, lo, hi);
-    }
-    // A finished cell holds coincident vertices; before that it is one vertex.
-    const uint32_t copies = complete ? cell.population : 1;
-    for (uint32_t i = 0; i < copies; ++i) out.positions.insert(out.positions.end(), position, position + 3);
-  });
-  const uint32_t n = uint32_t(out.vertexCount());
-  out.points.resize(n);
-  for (uint32_t i = 0; i < n; ++i) out.points[i] = i;
-}
+void Decoder::snapshot(Complex& out) const { state_->snapshot(out, false); }
 
 Complex Decoder::snapshot() const {
   Complex c;
@@ -474,7 +482,7 @@ Status decode(const uint8_t* data, size_t size, Complex& out, bool allowPrefix,
   if (!status.ok()) return status;
   if (!allowPrefix)
     if (status = decoder.finish(); !status.ok()) return status;
-  decoder.snapshot(out);
+  decoder.state_->snapshot(out, true);
   return Status::success();
 }
 

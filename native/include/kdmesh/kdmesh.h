@@ -276,6 +276,9 @@ class Decoder {
  private:
   struct State;
   std::unique_ptr<State> state_;
+  // decode() takes the complete model's lists from its decoder instead of
+  // copying them.
+  friend Status decode(const uint8_t*, size_t, Complex&, bool, const DecoderOptions&);
 };
 
 // Decodes a whole stream, or the longest decodable prefix of it when
