@@ -123,16 +123,15 @@ bool PositionPredictor::gather(uint32_t vertex, Neighbourhood& around) const {
   const uint32_t* neighbour = neighbours_.data() + firstNeighbour_[vertex];
   const uint32_t count = firstNeighbour_[vertex + 1] - firstNeighbour_[vertex];
   if (count == 0) return false;
-  double atX, atY, atZ;
-  centre(places_[vertex], atX, atY, atZ);
+  // Scalars rather than arrays: this loop, the decoder's hottest, stalled on
+  // store-to-load forwarding with array temporaries.
+  const double* at = places_[vertex].centre;
+  const double atX = at[0], atY = at[1], atZ = at[2];
   double sumX = 0, sumY = 0, sumZ = 0, normalX = 0, normalY = 0, normalZ = 0, squared = 0;
   double previousX = 0, previousY = 0, previousZ = 0;  // the first cross product is zero
   for (uint32_t i = 0; i < count; ++i) {
-    double x, y, z;
-    centre(places_[neighbour[i]], x, y, z);
-    x -= atX;
-    y -= atY;
-    z -= atZ;
+    const double* centre = places_[neighbour[i]].centre;
+    const double x = centre[0] - atX, y = centre[1] - atY, z = centre[2] - atZ;
     sumX += x;
     sumY += y;
     sumZ += z;

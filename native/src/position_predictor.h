@@ -65,11 +65,9 @@ class PositionPredictor {
   // coordinate bits.
   void place(uint32_t vertex, const uint32_t prefix[3], int level) {
     if (vertex >= places_.size()) places_.resize(std::max<size_t>(vertex + 1, places_.size() * 2));
-    Place& state = places_[vertex];
-    state.prefix[0] = prefix[0];
-    state.prefix[1] = prefix[1];
-    state.prefix[2] = prefix[2];
-    state.level = uint32_t(level);
+    const LevelGeometry& cell = levels_[size_t(level)];
+    for (int a = 0; a < 3; ++a)
+      places_[vertex].centre[a] = double(prefix[a]) * cell.width[a] + cell.centreOffset[a];
   }
 
   // Takes the neighbour lists of `store`'s vertices, for the predictions
@@ -104,10 +102,10 @@ class PositionPredictor {
                                    inFirstHalf != c.mirrored);
       first = bit != c.mirrored;
     }
-    Place& p = places_[vertex];
+    // The half's centre lies a quarter of the cell's width below or above.
     const int axis = axis_[size_t(level)];
-    p.prefix[axis] = p.prefix[axis] << 1 | uint32_t(!first);
-    p.level = uint32_t(level + 1);
+    const double quarter = levels_[size_t(level)].width[axis] * 0.25;
+    places_[vertex].centre[axis] += first ? -quarter : quarter;
     return first;
   }
 
@@ -116,7 +114,9 @@ class PositionPredictor {
   // The split axis of a geometric `level`, and the centre of a vertex's
   // current cell in grid units.
   int axis(int level) const { return axis_[size_t(level)]; }
-  void centreOf(uint32_t vertex, double out[3]) const { centre(places_[vertex], out[0], out[1], out[2]); }
+  void centreOf(uint32_t vertex, double out[3]) const {
+    for (int a = 0; a < 3; ++a) out[a] = places_[vertex].centre[a];
+  }
 
   const std::vector<BitModel>& models() const { return models_; }
   const std::vector<BitModel>& planeModels() const { return planeModels_; }
@@ -129,9 +129,12 @@ class PositionPredictor {
   }
 
  private:
+  // The centre of a vertex's current cell in grid units, kept as the cell
+  // shrinks rather than computed from its coordinate bits at every look (in
+  // gather(), a second dependent load and nine operations per neighbour).
+  // Exact: centres are multiples of 1/2 below 2^34.
   struct Place {
-    uint32_t prefix[3];
-    uint32_t level;
+    double centre[3];
   };
 
   // Sums over the neighbours' cell centres, relative to the vertex's cell
@@ -167,14 +170,6 @@ class PositionPredictor {
     bool mirrored;
   };
   bool contextsOf(uint32_t vertex, int level, SingleContexts& contexts);
-  // Scalars rather than an array: gather(), the decoder's hottest loop,
-  // stalled on store-to-load forwarding with array temporaries.
-  void centre(const Place& place, double& x, double& y, double& z) const {
-    const LevelGeometry& cell = levels_[place.level];
-    x = double(place.prefix[0]) * cell.width[0] + cell.centreOffset[0];
-    y = double(place.prefix[1]) * cell.width[1] + cell.centreOffset[1];
-    z = double(place.prefix[2]) * cell.width[2] + cell.centreOffset[2];
-  }
 
   std::vector<uint8_t> axis_;                  // split axis per level
   std::vector<LevelGeometry> levels_;
