@@ -55,7 +55,6 @@ class GeometrySet {
   // (see mark()).
   stage(name, geometryIndex, storage, used, itemSize) {
     const attribute = adoptAttribute(this.geometries[geometryIndex], name, storage, itemSize);
-    usedBytes.set(storage, 0);
     if (used > 0) this.queue.push({ attribute, marked: 0, used });
     return attribute;
   }
@@ -85,16 +84,42 @@ class GeometrySet {
   }
 }
 
+/**
+ * Tells whether the GPU has finished the WebGL work issued before the last
+ * set(), without waiting: WebGL calls made while the GPU is still busy block
+ * the page's main thread until it is done (under software WebGL, up to a
+ * second per frame of a large model). Draw a frame only once passed().
+ */
+export class GpuFence {
+  constructor(gl) {
+    this.gl = gl;
+    this.sync = null;
+  }
+
+  passed() {
+    if (!this.sync) return true;
+    if (this.gl.clientWaitSync(this.sync, 0, 0) === this.gl.TIMEOUT_EXPIRED) return false;
+    this.gl.deleteSync(this.sync);
+    this.sync = null;
+    return true;
+  }
+
+  set() {
+    this.sync = this.gl.fenceSync(this.gl.SYNC_GPU_COMMANDS_COMPLETE, 0);
+    this.gl.flush();
+  }
+}
+
 // Uploads the next level of models in slices, between the page's frames,
 // on a renderer passed to prepareRenderer(). Under software WebGL in
-// Chromium an upload costs the page's main thread up to 4 ms per MB (the
-// dragon's last level holds 21 MB), and a level drawn before all of it
-// arrived would mix two levels' vertices and simplices. three.js uploads
-// the attributes of the objects it renders, so the slices ride on renders of
-// objects that draw nothing (an empty draw range, a trivial shader) into a
-// 1x1 target, which leave the canvas alone. A slice waits until the GPU has
-// finished all earlier work (a fence, polled without waiting), or the upload
-// would block the page until it had.
+// Chromium uploads block the page's main thread (a frame uploading half of
+// the dragon's last level, ~10 MB, ran 39-47 ms of script), and a level
+// drawn before all of it arrived would mix two levels' vertices and
+// simplices. three.js uploads the attributes of the objects it renders, so
+// the slices ride on renders of objects that draw nothing (an empty draw
+// range, a trivial shader) into a 1x1 target, which leave the canvas alone.
+// A slice waits until the GPU has finished all earlier work (GpuFence), or
+// the upload would block the page until it had.
 class SlicedUploads {
   constructor(renderer, camera, bytesPerSlice) {
     this.renderer = renderer;
@@ -106,7 +131,7 @@ class SlicedUploads {
       vertexShader: 'void main() { gl_Position = vec4(0.0); }',
       fragmentShader: 'void main() { gl_FragColor = vec4(0.0); }',
     });
-    this.fence = null;
+    this.gpu = new GpuFence(renderer.getContext());
   }
 
   // Objects that upload the geometries they are given (a model's three).
@@ -118,19 +143,9 @@ class SlicedUploads {
     });
   }
 
-  idle() {
-    if (!this.fence) return true;
-    const gl = this.renderer.getContext();
-    if (gl.clientWaitSync(this.fence, 0, 0) === gl.TIMEOUT_EXPIRED) return false;
-    gl.deleteSync(this.fence);
-    this.fence = null;
-    return true;
-  }
-
   // Sends what is marked in the uploaders' geometries to the GPU.
   run(uploaders) {
     const { renderer } = this;
-    const gl = renderer.getContext();
     for (const object of uploaders) object.geometry.setDrawRange(0, 0);
     this.scene.add(...uploaders);
     const target = renderer.getRenderTarget();
@@ -138,8 +153,7 @@ class SlicedUploads {
     renderer.render(this.scene, this.camera);
     renderer.setRenderTarget(target);
     this.scene.remove(...uploaders);
-    this.fence = gl.fenceSync(gl.SYNC_GPU_COMMANDS_COMPLETE, 0);
-    gl.flush();
+    this.gpu.set();
   }
 
   dispose() {
@@ -425,7 +439,7 @@ export class KDMeshLoader extends Loader {
       if (uploads) {
         uploaders.forEach((object, i) => (object.geometry = back.geometries[i]));
         while (back.pending) {
-          if (uploads.idle()) {
+          if (uploads.gpu.passed()) {
             back.mark(uploads.bytesPerSlice);
             uploads.run(uploaders);
           }

@@ -3,7 +3,7 @@
 // in window.kdmeshViewer.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
-import { KDMeshLoader } from 'kdmesh/three';
+import { GpuFence, KDMeshLoader } from 'kdmesh/three';
 import { modelChecksum } from './model-checksum.js';
 
 const $ = (id) => document.getElementById(id);
@@ -102,33 +102,21 @@ window.addEventListener('resize', resize);
 resize();
 // Frames are drawn on demand (camera moves, refinements, resizes): a
 // software-rendered page with a large model stays responsive. A frame is
-// drawn only once the GPU has finished the previous one (a fence, polled
-// without waiting): WebGL calls issued while the GPU is busy block the main
-// thread until it is done (under software WebGL, a second per frame of the
-// 871k-triangle dragon), and so do uploads into a busy GPU.
-const gl = renderer.getContext();
+// drawn only once the GPU has finished the previous one (see GpuFence).
+const previousFrame = new GpuFence(renderer.getContext());
 let frameRequested = false;
-let inFlight = null;  // fence behind the last frame drawn
-function gpuIdle() {
-  if (!inFlight) return true;
-  if (gl.clientWaitSync(inFlight, 0, 0) === gl.TIMEOUT_EXPIRED) return false;
-  gl.deleteSync(inFlight);
-  inFlight = null;
-  return true;
-}
 function requestRender() {
   if (frameRequested) return;
   frameRequested = true;
   requestAnimationFrame(function tick() {
-    if (!gpuIdle()) {
+    if (!previousFrame.passed()) {
       requestAnimationFrame(tick);
       return;
     }
     frameRequested = false;
     controls.update();
     renderer.render(scene, camera);
-    inFlight = gl.fenceSync(gl.SYNC_GPU_COMMANDS_COMPLETE, 0);
-    gl.flush();
+    previousFrame.set();
     const elapsed = performance.now() - loadBegan;
     if (viewer.refinements > 0 && viewer.firstRenderMs === null) viewer.firstRenderMs = elapsed;
     if (viewer.state === 'complete' && viewer.finalRenderMs === null) viewer.finalRenderMs = elapsed;

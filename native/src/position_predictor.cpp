@@ -54,13 +54,10 @@ PositionPredictor::PositionPredictor(const SplitSchedule& schedule)
   primeModels(ModelFamily::OneVertexSplits, models_.data());
   primeModels(ModelFamily::OneVertexByPlane, planeModels_.data());
   primeModels(ModelFamily::OneVertexByCentroid, centroidModels_.data());
-  levels_.resize(size_t(schedule.levels) + 1);
-  for (size_t level = 0; level < levels_.size(); ++level)
-    for (int a = 0; a < 3; ++a) {
-      const double width = std::ldexp(1.0, schedule.bits[size_t(a)] - schedule.consumed[level][size_t(a)]);
-      levels_[level].width[a] = width;
-      levels_[level].centreOffset[a] = (width - 1) * 0.5;
-    }
+  widths_.resize(size_t(schedule.levels) + 1);
+  for (size_t level = 0; level < widths_.size(); ++level)
+    for (int a = 0; a < 3; ++a)
+      widths_[level][size_t(a)] = std::ldexp(1.0, schedule.bits[size_t(a)] - schedule.consumed[level][size_t(a)]);
 }
 
 void PositionPredictor::snapshotNeighbours(const SimplexStore& store, uint64_t splits) {
@@ -90,7 +87,7 @@ PositionPredictor::Features PositionPredictor::features(const Neighbourhood& aro
   Features f;
   const int axis = axis_[size_t(level)];
   double halfWidth[3];
-  for (int a = 0; a < 3; ++a) halfWidth[a] = levels_[size_t(level)].width[a] * 0.5;
+  for (int a = 0; a < 3; ++a) halfWidth[a] = widths_[size_t(level)][size_t(a)] * 0.5;
   const double inverse = 1.0 / double(around.count);
   double centroid[3];  // relative to the cell centre
   for (int a = 0; a < 3; ++a) centroid[a] = around.sum[a] * inverse;

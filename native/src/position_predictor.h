@@ -65,9 +65,8 @@ class PositionPredictor {
   // coordinate bits.
   void place(uint32_t vertex, const uint32_t prefix[3], int level) {
     if (vertex >= places_.size()) places_.resize(std::max<size_t>(vertex + 1, places_.size() * 2));
-    const LevelGeometry& cell = levels_[size_t(level)];
-    for (int a = 0; a < 3; ++a)
-      places_[vertex].centre[a] = double(prefix[a]) * cell.width[a] + cell.centreOffset[a];
+    const std::array<double, 3>& width = widths_[size_t(level)];
+    for (int a = 0; a < 3; ++a) places_[vertex].centre[a] = double(prefix[a]) * width[a] + (width[a] - 1) * 0.5;
   }
 
   // Takes the neighbour lists of `store`'s vertices, for the predictions
@@ -104,7 +103,7 @@ class PositionPredictor {
     }
     // The half's centre lies a quarter of the cell's width below or above.
     const int axis = axis_[size_t(level)];
-    const double quarter = levels_[size_t(level)].width[axis] * 0.25;
+    const double quarter = widths_[size_t(level)][size_t(axis)] * 0.25;
     places_[vertex].centre[axis] += first ? -quarter : quarter;
     return first;
   }
@@ -132,7 +131,8 @@ class PositionPredictor {
   // The centre of a vertex's current cell in grid units, kept as the cell
   // shrinks rather than computed from its coordinate bits at every look (in
   // gather(), a second dependent load and nine operations per neighbour).
-  // Exact: centres are multiples of 1/2 below 2^34.
+  // Exact: centres are multiples of 1/2 below 2^32 (grids have at most 32
+  // bits).
   struct Place {
     double centre[3];
   };
@@ -143,11 +143,6 @@ class PositionPredictor {
     double sum[3], normal[3];
     double squaredDistance;
     uint32_t count;
-  };
-  // Cell width per axis at a level, and the offset of a cell's centre from
-  // its lowest grid coordinate.
-  struct LevelGeometry {
-    double width[3], centreOffset[3];
   };
   // The predictions against the split at `level`, in half widths of the
   // cell along the split axis, mirrored so that the plane (or without one,
@@ -172,7 +167,7 @@ class PositionPredictor {
   bool contextsOf(uint32_t vertex, int level, SingleContexts& contexts);
 
   std::vector<uint8_t> axis_;                  // split axis per level
-  std::vector<LevelGeometry> levels_;
+  std::vector<std::array<double, 3>> widths_;  // cell width per level and axis
   std::vector<Place> places_;
   // The complex's edges as neighbour lists (compressed rows) at the last
   // snapshot: contiguous lists let the lookups of a vertex's neighbours

@@ -76,7 +76,7 @@ void gatherStar(SimplexStore& store, uint32_t v, std::vector<StarEntry>& star,
       int n = 0;
       for (int i = 0; i <= d; ++i)
         if (i != int(position)) entry.others[n++] = vertices[i];
-      // At most three: a sorting network of minima and maxima (no branches).
+      // At most three: a sorting network of minima and maxima.
       auto order = [&entry](int i, int j) {
         const uint32_t low = std::min(entry.others[i], entry.others[j]);
         entry.others[j] = std::max(entry.others[i], entry.others[j]);
