@@ -34,7 +34,7 @@ struct CountContext {
 
 class CountCoder {
  public:
-  static constexpr int kNeighbourhoodClasses = 9;
+  static constexpr int kNeighbourhoodClasses = 13;
 
   // `neighbourhoods`: code() may be given neighbourhood classes (streams
   // with connectivity).

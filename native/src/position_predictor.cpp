@@ -9,6 +9,7 @@ namespace {
 
 constexpr int kScaleClasses = 5;
 constexpr int kTiltClasses = 5;  // the last: no plane
+constexpr int kOutsideClasses = 2;
 constexpr int kPlaneBuckets = 6;
 constexpr int kCentroidBuckets = 10;
 
@@ -42,14 +43,15 @@ int centroidBucket(double t) {
 
 PositionPredictor::PositionPredictor(const SplitSchedule& schedule)
     : axis_(schedule.axis),
-      models_(size_t(kScaleClasses) * kTiltClasses * kPlaneBuckets * kCentroidBuckets),
-      planeModels_(size_t(kScaleClasses) * kTiltClasses * kPlaneBuckets),
+      models_(size_t(kOutsideClasses) * kScaleClasses * kTiltClasses * kPlaneBuckets * kCentroidBuckets),
+      planeModels_(size_t(kOutsideClasses) * kScaleClasses * kTiltClasses * kPlaneBuckets),
       centroidModels_(size_t(kScaleClasses) * kCentroidBuckets),
       // The joint model is the sharpest; the others help while it learns.
       mixer_(kScaleClasses, {39322, 19661, 19661}) {
-  static_assert(size_t(kScaleClasses) * kTiltClasses * kPlaneBuckets * kCentroidBuckets ==
+  static_assert(size_t(kOutsideClasses) * kScaleClasses * kTiltClasses * kPlaneBuckets * kCentroidBuckets ==
                 kFamilySize[int(ModelFamily::OneVertexSplits)]);
-  static_assert(size_t(kScaleClasses) * kTiltClasses * kPlaneBuckets == kFamilySize[int(ModelFamily::OneVertexByPlane)]);
+  static_assert(size_t(kOutsideClasses) * kScaleClasses * kTiltClasses * kPlaneBuckets ==
+                kFamilySize[int(ModelFamily::OneVertexByPlane)]);
   static_assert(size_t(kScaleClasses) * kCentroidBuckets == kFamilySize[int(ModelFamily::OneVertexByCentroid)]);
   primeModels(ModelFamily::OneVertexSplits, models_.data());
   primeModels(ModelFamily::OneVertexByPlane, planeModels_.data());
@@ -60,27 +62,66 @@ PositionPredictor::PositionPredictor(const SplitSchedule& schedule)
       widths_[level][size_t(a)] = std::ldexp(1.0, schedule.bits[size_t(a)] - schedule.consumed[level][size_t(a)]);
 }
 
+namespace {
+
+// Turns per-vertex counts in first[v + 1] into row starts.
+void startRows(std::vector<uint32_t>& first) {
+  for (size_t v = 1; v < first.size(); ++v) first[v] += first[v - 1];
+}
+
+// After a fill that advanced each row start to the next row's, shifts the
+// starts back.
+void restoreRows(std::vector<uint32_t>& first) {
+  for (size_t v = first.size() - 1; v > 0; --v) first[v] = first[v - 1];
+  first[0] = 0;
+}
+
+}  // namespace
+
 void PositionPredictor::snapshotNeighbours(const SimplexStore& store, uint64_t splits) {
   if (splits == snapshotSplits_) return;
   snapshotSplits_ = splits;
-  const uint32_t vertexCount = uint32_t(places_.size());
-  firstNeighbour_.assign(size_t(vertexCount) + 1, 0);
+  const size_t rows = places_.size() + 1;
+  firstWing_.assign(rows, 0);
+  const uint32_t triangles = store.size(2);
+  for (uint32_t triangle = 0; triangle < triangles; ++triangle) {
+    const uint32_t* v = store.vertices(2, triangle);
+    for (int i = 0; i < 3; ++i) ++firstWing_[v[i] + 1];
+  }
+  startRows(firstWing_);
+  wings_.resize(size_t(firstWing_.back()) * 2);
+  for (uint32_t triangle = 0; triangle < triangles; ++triangle) {
+    const uint32_t* v = store.vertices(2, triangle);
+    // The winding: the tuple, or with its first two swapped when flipped.
+    const bool flipped = store.flags(2, triangle) & SimplexStore::kFlipped;
+    const uint32_t w0 = v[flipped ? 1 : 0], w1 = v[flipped ? 0 : 1], w2 = v[2];
+    const auto addWing = [&](uint32_t at, uint32_t a, uint32_t b) {
+      uint32_t* wing = &wings_[size_t(firstWing_[at]++) * 2];
+      wing[0] = a;
+      wing[1] = b;
+    };
+    addWing(w0, w1, w2);
+    addWing(w1, w2, w0);
+    addWing(w2, w0, w1);
+  }
+  restoreRows(firstWing_);
+
+  auto wingless = [&](uint32_t v) { return firstWing_[v] == firstWing_[v + 1]; };
+  firstNeighbour_.assign(rows, 0);
   const uint32_t edges = store.size(1);
   for (uint32_t edge = 0; edge < edges; ++edge) {
     const uint32_t* v = store.vertices(1, edge);
-    ++firstNeighbour_[v[0] + 1];
-    ++firstNeighbour_[v[1] + 1];
+    for (int i = 0; i < 2; ++i) firstNeighbour_[v[i] + 1] += wingless(v[i]);
   }
-  for (uint32_t v = 0; v < vertexCount; ++v) firstNeighbour_[v + 1] += firstNeighbour_[v];
-  neighbours_.resize(firstNeighbour_[vertexCount]);
-  for (uint32_t edge = 0; edge < edges; ++edge) {
+  startRows(firstNeighbour_);
+  neighbours_.resize(firstNeighbour_.back());
+  // Meshes: every vertex with an edge has a triangle.
+  for (uint32_t edge = 0; edge < edges && !neighbours_.empty(); ++edge) {
     const uint32_t* v = store.vertices(1, edge);
-    neighbours_[firstNeighbour_[v[0]]++] = v[1];
-    neighbours_[firstNeighbour_[v[1]]++] = v[0];
+    for (int i = 0; i < 2; ++i)
+      if (wingless(v[i])) neighbours_[firstNeighbour_[v[i]]++] = v[1 - i];
   }
-  // The fill advanced each start to the next row's; shift them back.
-  for (uint32_t v = vertexCount; v > 0; --v) firstNeighbour_[v] = firstNeighbour_[v - 1];
-  firstNeighbour_[0] = 0;
+  restoreRows(firstNeighbour_);
 }
 
 PositionPredictor::Features PositionPredictor::features(const Neighbourhood& around, int level) const {
@@ -108,6 +149,7 @@ PositionPredictor::Features PositionPredictor::features(const Neighbourhood& aro
     f.hasPlane = true;
   }
   f.mirrored = (f.hasPlane ? f.planeOffset : f.centroidOffset) < 0;
+  f.outsideUp = around.oriented && f.hasPlane && (normal[axis] > 0) != f.mirrored;
   if (f.mirrored) {
     f.planeOffset = -f.planeOffset;
     f.centroidOffset = -f.centroidOffset;
@@ -116,15 +158,36 @@ PositionPredictor::Features PositionPredictor::features(const Neighbourhood& aro
 }
 
 bool PositionPredictor::gather(uint32_t vertex, Neighbourhood& around) const {
-  if (size_t(vertex) + 1 >= firstNeighbour_.size()) return false;
-  const uint32_t* neighbour = neighbours_.data() + firstNeighbour_[vertex];
-  const uint32_t count = firstNeighbour_[vertex + 1] - firstNeighbour_[vertex];
-  if (count == 0) return false;
-  // Scalars rather than arrays: this loop, the decoder's hottest, stalled on
-  // store-to-load forwarding with array temporaries.
+  if (size_t(vertex) + 1 >= firstWing_.size()) return false;
+  // Scalars rather than arrays: these loops, the decoder's hottest, stalled
+  // on store-to-load forwarding with array temporaries.
   const double* at = places_[vertex].centre;
   const double atX = at[0], atY = at[1], atZ = at[2];
   double sumX = 0, sumY = 0, sumZ = 0, normalX = 0, normalY = 0, normalZ = 0, squared = 0;
+  const uint32_t wingCount = firstWing_[vertex + 1] - firstWing_[vertex];
+  if (wingCount > 0) {
+    // Each wing adds both its vertices (a closed fan thus counts every
+    // neighbour twice) and the cross product of their offsets.
+    const uint32_t* wing = wings_.data() + size_t(firstWing_[vertex]) * 2;
+    for (uint32_t i = 0; i < wingCount; ++i, wing += 2) {
+      const double* a = places_[wing[0]].centre;
+      const double* b = places_[wing[1]].centre;
+      const double ax = a[0] - atX, ay = a[1] - atY, az = a[2] - atZ;
+      const double bx = b[0] - atX, by = b[1] - atY, bz = b[2] - atZ;
+      sumX += ax + bx;
+      sumY += ay + by;
+      sumZ += az + bz;
+      squared += ax * ax + ay * ay + az * az + bx * bx + by * by + bz * bz;
+      normalX += ay * bz - az * by;
+      normalY += az * bx - ax * bz;
+      normalZ += ax * by - ay * bx;
+    }
+    around = {{sumX, sumY, sumZ}, {normalX, normalY, normalZ}, squared, 2 * wingCount, true};
+    return true;
+  }
+  const uint32_t* neighbour = neighbours_.data() + firstNeighbour_[vertex];
+  const uint32_t count = firstNeighbour_[vertex + 1] - firstNeighbour_[vertex];
+  if (count == 0) return false;
   double previousX = 0, previousY = 0, previousZ = 0;  // the first cross product is zero
   for (uint32_t i = 0; i < count; ++i) {
     const double* centre = places_[neighbour[i]].centre;
@@ -147,7 +210,7 @@ bool PositionPredictor::gather(uint32_t vertex, Neighbourhood& around) const {
     previousY = y;
     previousZ = z;
   }
-  around = {{sumX, sumY, sumZ}, {normalX, normalY, normalZ}, squared, count};
+  around = {{sumX, sumY, sumZ}, {normalX, normalY, normalZ}, squared, count, false};
   return true;
 }
 
@@ -159,7 +222,7 @@ bool PositionPredictor::contextsOf(uint32_t vertex, int level, SingleContexts& c
   c.mirrored = f.mirrored;
   const int tilt = f.hasPlane ? tiltClass(f.tilt) : kTiltClasses - 1;
   const int scale = scaleClass(f.meanSquaredDistance);
-  c.plane = (scale * kTiltClasses + tilt) * kPlaneBuckets + planeBucket(f.planeOffset);
+  c.plane = ((f.outsideUp * kScaleClasses + scale) * kTiltClasses + tilt) * kPlaneBuckets + planeBucket(f.planeOffset);
   c.joint = c.plane * kCentroidBuckets + centroidBucket(f.centroidOffset);
   c.centroid = scale * kCentroidBuckets + centroidBucket(f.centroidOffset);
   c.mixerSet = scale;
@@ -173,11 +236,21 @@ CountContext PositionPredictor::countContext(uint32_t vertex, int level) {
   const Features f = features(around, level);
   if (!f.hasPlane) {
     const double c = f.centroidOffset;
-    return {c < 0.5 ? 6 : c < 1.5 ? 7 : 8, f.mirrored};
+    return {c < 0.5 ? 10 : c < 1.5 ? 11 : 12, f.mirrored};
   }
-  // How close the plane comes to the split plane inside the cell, in half widths.
-  const double gap = f.planeOffset - f.tilt;
-  return {gap <= 0 ? 1 : gap < 0.5 ? 2 : gap < 1 ? 3 : gap < 2 ? 4 : 5, f.mirrored};
+  // The plane meets the cell's column along the split axis between
+  // planeOffset - tilt and planeOffset + tilt (in half widths).
+  const double low = f.planeOffset - f.tilt, high = f.planeOffset + f.tilt;
+  if (low > 0) {
+    // It stays in the upper half: how close it comes to the split plane.
+    return {low < 0.5 ? 6 : low < 1 ? 7 : low < 2 ? 8 : 9, f.mirrored};
+  }
+  // It crosses the split plane: which share of its span inside the cell
+  // lies in the lower half (at most about a half, since mirrored).
+  const double inside = std::min(high, 1.0) - std::max(low, -1.0);
+  const double below = std::min(high, 0.0) - std::max(low, -1.0);
+  static constexpr double kShareBounds[4] = {0.08, 0.2, 0.32, 0.44};
+  return {1 + countAtMost(inside > 0 && below > 0 ? below / inside : 0.0, kShareBounds), f.mirrored};
 }
 
 }  // namespace kdmesh

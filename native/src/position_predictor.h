@@ -5,9 +5,12 @@
 // the split axis; without connectivity that bit is close to a coin toss. The
 // vertex's neighbours (cells of the current level, taken at their centres)
 // say where it should be: near their centroid and, on a surface, on the
-// plane through that centroid whose normal sums the cross products of
-// consecutive neighbour offsets, each turned to agree with the sum so far
-// (the plane's orientation does not matter, so the neighbours need no order).
+// plane through that centroid. The plane's normal sums the cross products of
+// the vertex's triangles (each as the two other vertices in the triangle's
+// winding), so it also says which side is the surface's outside. A vertex in
+// no triangle (of a wireframe, say) sums the cross products of consecutive
+// neighbour offsets instead, each turned to agree with the sum so far; that
+// plane has no outside.
 //
 // Both predictions become features measured in the cell's half width along
 // the split axis:
@@ -17,7 +20,10 @@
 //     nothing;
 //   - where the centroid lies relative to the split plane;
 //   - the neighbours' distance against the cell size (coarse cells are
-//     larger than the gaps between neighbours and predict little).
+//     larger than the gaps between neighbours and predict little);
+//   - whether the outside lies towards the predicted half (surfaces curve
+//     away from their outside more often than not, so a vertex sits on the
+//     outer side of its neighbours' plane).
 // The configuration is mirrored so that the prediction points to the upper
 // half, which lets the two mirror images share statistics. A one-vertex split
 // mixes three models chosen by these features (mixer.h); the split of a cell
@@ -79,9 +85,10 @@ class PositionPredictor {
   void snapshotNeighbours(const SimplexStore& store, uint64_t splits);
 
   // The neighbourhood class of the split of a cell of several vertices at
-  // `level` whose vertex in the complex is `vertex`: how close its
-  // neighbourhood's plane comes to the split plane (1..5, or 6..8 from the
-  // centroid alone without a plane, 0 without neighbours).
+  // `level` whose vertex in the complex is `vertex`: for a plane through the
+  // cell that crosses the split plane, which share of it lies on the lesser
+  // side (1..5); for one that does not, how close it comes (6..9); without a
+  // plane, where the centroid lies (10..12); 0 without neighbours.
   CountContext countContext(uint32_t vertex, int level);
 
   // Codes whether the vertex of a one-vertex cell at `level` lies in its
@@ -138,11 +145,13 @@ class PositionPredictor {
   };
 
   // Sums over the neighbours' cell centres, relative to the vertex's cell
-  // centre; the normal: see the top of this file.
+  // centre; the normal: see the top of this file. `oriented`: the normal
+  // comes from the triangles' winding and points outside.
   struct Neighbourhood {
     double sum[3], normal[3];
     double squaredDistance;
     uint32_t count;
+    bool oriented;
   };
   // The predictions against the split at `level`, in half widths of the
   // cell along the split axis, mirrored so that the plane (or without one,
@@ -153,6 +162,7 @@ class PositionPredictor {
     double centroidOffset = 0;
     double meanSquaredDistance = 0;  // of the neighbours, in squared half widths
     bool hasPlane = false, mirrored = false;
+    bool outsideUp = false;  // an oriented normal points to the upper half
   };
   Features features(const Neighbourhood& around, int level) const;
   // Sums the neighbours of `vertex` in the snapshot; false without any.
@@ -169,10 +179,12 @@ class PositionPredictor {
   std::vector<uint8_t> axis_;                  // split axis per level
   std::vector<std::array<double, 3>> widths_;  // cell width per level and axis
   std::vector<Place> places_;
-  // The complex's edges as neighbour lists (compressed rows) at the last
-  // snapshot: contiguous lists let the lookups of a vertex's neighbours
-  // proceed in parallel, where the store's linked incidence lists would
-  // chain them.
+  // At the last snapshot, per vertex (compressed rows): its triangles as
+  // "wings", the pairs of other vertices in winding order, and for vertices
+  // in no triangle, the other ends of their edges. Contiguous lists let the
+  // lookups of a vertex's neighbours proceed in parallel, where the store's
+  // linked incidence lists would chain them.
+  std::vector<uint32_t> firstWing_, wings_;
   std::vector<uint32_t> firstNeighbour_, neighbours_;
   uint64_t snapshotSplits_ = ~uint64_t(0);
   std::vector<BitModel> models_, planeModels_, centroidModels_;
