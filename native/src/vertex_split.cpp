@@ -176,6 +176,23 @@ void VertexSplitter::classifyEdges(uint32_t v, int level) {
   }
 }
 
+void VertexSplitter::orderCodes(bool geometric) {
+  codingOrder_.resize(star_.size());
+  for (size_t i = 0; i < star_.size(); ++i) codingOrder_[i] = uint32_t(i);
+  if (!geometric) return;
+  // An insertion sort: stars are short, and it is stable (edges at equal
+  // angles keep their canonical order) without a buffer.
+  const size_t first = begin_[1], last = begin_[2];
+  for (size_t i = first + 1; i < last; ++i) {
+    const uint32_t edge = codingOrder_[i];
+    const double steepness = std::fabs(cosines_[edge - first]);
+    size_t j = i;
+    for (; j > first && std::fabs(cosines_[codingOrder_[j - 1] - first]) < steepness; --j)
+      codingOrder_[j] = codingOrder_[j - 1];
+    codingOrder_[j] = edge;
+  }
+}
+
 // Edges of the star that share a triangle are fan neighbours: around a
 // manifold vertex the codes run 1...1 4 2...2 4 along the fan, so the codes
 // already given to an edge's fan neighbours say much about its own. Two
