@@ -115,7 +115,7 @@ struct Decoder::State {
         const uint32_t cap = uint32_t(std::min<uint64_t>(caps[size_t(d)], 0xffffffffu));
         store.setCapacity(d, cap, uint32_t(std::min<uint64_t>(cap, plausible)));
       }
-      predictor.emplace(*schedule);
+      predictor.emplace(*schedule, store);
       splitter.emplace(store, *predictor);
       predictor->place(0, root.prefix, 0);
     }
@@ -133,13 +133,11 @@ struct Decoder::State {
         return Status::error(ErrorCode::CorruptChunk,
                              where + ": more splits than the kd-tree has cells");
       if (cursor < cells.size()) {
-        if (connectivity && cursor == 0 && level < schedule->levels) snapshotNeighbours();
         if (!splitCell(cells[cursor++]))
           return Status::error(ErrorCode::CorruptChunk, where + ": inconsistent connectivity codes");
         --left;
       } else {
         const size_t count = std::min<size_t>(left, singleLevelEnd - singleCursor);
-        if (connectivity && singleCursor == 0 && count > 0) snapshotNeighbours();
         refineSingles(singleCursor, singleCursor + count);
         singleCursor += count;
         left -= uint32_t(count);
@@ -169,7 +167,6 @@ struct Decoder::State {
     return Status::success();
   }
 
-  void snapshotNeighbours() { predictor->snapshotNeighbours(store, splitter->statistics().vertexSplits); }
 
   // Returns false on connectivity codes that contradict each other.
   bool splitCell(const Cell& cell) {

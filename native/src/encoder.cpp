@@ -110,11 +110,9 @@ class ChunkWriter {
 // The visitor sees cell(level, geometric, population, firstHalf,
 // parentOneSided, keptId, addedId) for cells of several vertices (addedId is
 // kNoSimplex for a one-sided split), placed(id, prefix, level) for each
-// non-empty half of a geometric split, snapshot() before the cells of
-// several vertices and again before those of one vertex of a geometric
-// level, single(level, parentOneSided, inFirstHalf, id) for one-vertex
-// cells, named(keyIndex, id) when a vertex gets its final id, and
-// splitDone() after each split.
+// non-empty half of a geometric split, single(level, parentOneSided,
+// inFirstHalf, id) for one-vertex cells, named(keyIndex, id) when a vertex
+// gets its final id, and splitDone() after each split.
 template <class Visitor>
 void traverseKdTree(const std::vector<KdKey>& keys, const SplitSchedule& schedule,
                     bool coincidentLevels, Visitor&& visitor) {
@@ -146,7 +144,6 @@ void traverseKdTree(const std::vector<KdKey>& keys, const SplitSchedule& schedul
     const size_t oldSingles = singles.size();
     const size_t singleLevelEnd = geometric ? oldSingles : 0;
     children.clear();
-    if (geometric && !cells.empty()) visitor.snapshot();
     for (const Cell& cell : cells) {
       const uint32_t population = cell.end - cell.begin;
       const uint32_t split =
@@ -178,7 +175,6 @@ void traverseKdTree(const std::vector<KdKey>& keys, const SplitSchedule& schedul
       }
       visitor.splitDone();
     }
-    if (singleLevelEnd > 0) visitor.snapshot();
     for (size_t i = 0; i < singleLevelEnd; ++i) {
       Single& single = singles[i];
       visitor.single(level, single.parentOneSided, ((keys[single.key] >> bit) & 1) == 0, single.id);
@@ -239,7 +235,6 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
         if (added != kNoSimplex) splits.push_back({kept, added});
       }
       void placed(uint32_t, const uint32_t*, int) {}
-      void snapshot() {}
       void single(int, bool, bool, uint32_t) {}
       void named(uint32_t key, uint32_t id) { ids[vertexOfKey[key]] = id; }
       void splitDone() {}
@@ -265,7 +260,7 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
   CountCoder counts(schedule.levels, connectivity);
   SimplexStore forward;
   forward.reset(header.vertexCount, false);
-  PositionPredictor predictor(schedule);
+  PositionPredictor predictor(schedule, forward);
   VertexSplitter splitter(forward, predictor);
   size_t splitIndex = 0;
   double connectivityBits = 0;
@@ -303,9 +298,6 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
     }
     void placed(uint32_t id, const uint32_t* prefix, int level) {
       if (connectivity) predictor.place(id, prefix, level);
-    }
-    void snapshot() {
-      if (connectivity) predictor.snapshotNeighbours(forward, splitter.statistics().vertexSplits);
     }
     void single(int level, bool parentOneSided, bool inFirstHalf, uint32_t id) {
       if (connectivity)

@@ -41,8 +41,9 @@ int centroidBucket(double t) {
 
 }  // namespace
 
-PositionPredictor::PositionPredictor(const SplitSchedule& schedule)
+PositionPredictor::PositionPredictor(const SplitSchedule& schedule, const SimplexStore& store)
     : axis_(schedule.axis),
+      store_(store),
       models_(size_t(kOutsideClasses) * kScaleClasses * kTiltClasses * kPlaneBuckets * kCentroidBuckets),
       planeModels_(size_t(kOutsideClasses) * kScaleClasses * kTiltClasses * kPlaneBuckets),
       centroidModels_(size_t(kScaleClasses) * kCentroidBuckets),
@@ -60,68 +61,6 @@ PositionPredictor::PositionPredictor(const SplitSchedule& schedule)
   for (size_t level = 0; level < widths_.size(); ++level)
     for (int a = 0; a < 3; ++a)
       widths_[level][size_t(a)] = std::ldexp(1.0, schedule.bits[size_t(a)] - schedule.consumed[level][size_t(a)]);
-}
-
-namespace {
-
-// Turns per-vertex counts in first[v + 1] into row starts.
-void startRows(std::vector<uint32_t>& first) {
-  for (size_t v = 1; v < first.size(); ++v) first[v] += first[v - 1];
-}
-
-// After a fill that advanced each row start to the next row's, shifts the
-// starts back.
-void restoreRows(std::vector<uint32_t>& first) {
-  for (size_t v = first.size() - 1; v > 0; --v) first[v] = first[v - 1];
-  first[0] = 0;
-}
-
-}  // namespace
-
-void PositionPredictor::snapshotNeighbours(const SimplexStore& store, uint64_t splits) {
-  if (splits == snapshotSplits_) return;
-  snapshotSplits_ = splits;
-  const size_t rows = places_.size() + 1;
-  firstWing_.assign(rows, 0);
-  const uint32_t triangles = store.size(2);
-  for (uint32_t triangle = 0; triangle < triangles; ++triangle) {
-    const uint32_t* v = store.vertices(2, triangle);
-    for (int i = 0; i < 3; ++i) ++firstWing_[v[i] + 1];
-  }
-  startRows(firstWing_);
-  wings_.resize(size_t(firstWing_.back()) * 2);
-  for (uint32_t triangle = 0; triangle < triangles; ++triangle) {
-    const uint32_t* v = store.vertices(2, triangle);
-    // The winding: the tuple, or with its first two swapped when flipped.
-    const bool flipped = store.flags(2, triangle) & SimplexStore::kFlipped;
-    const uint32_t w0 = v[flipped ? 1 : 0], w1 = v[flipped ? 0 : 1], w2 = v[2];
-    const auto addWing = [&](uint32_t at, uint32_t a, uint32_t b) {
-      uint32_t* wing = &wings_[size_t(firstWing_[at]++) * 2];
-      wing[0] = a;
-      wing[1] = b;
-    };
-    addWing(w0, w1, w2);
-    addWing(w1, w2, w0);
-    addWing(w2, w0, w1);
-  }
-  restoreRows(firstWing_);
-
-  auto wingless = [&](uint32_t v) { return firstWing_[v] == firstWing_[v + 1]; };
-  firstNeighbour_.assign(rows, 0);
-  const uint32_t edges = store.size(1);
-  for (uint32_t edge = 0; edge < edges; ++edge) {
-    const uint32_t* v = store.vertices(1, edge);
-    for (int i = 0; i < 2; ++i) firstNeighbour_[v[i] + 1] += wingless(v[i]);
-  }
-  startRows(firstNeighbour_);
-  neighbours_.resize(firstNeighbour_.back());
-  // Meshes: every vertex with an edge has a triangle.
-  for (uint32_t edge = 0; edge < edges && !neighbours_.empty(); ++edge) {
-    const uint32_t* v = store.vertices(1, edge);
-    for (int i = 0; i < 2; ++i)
-      if (wingless(v[i])) neighbours_[firstNeighbour_[v[i]]++] = v[1 - i];
-  }
-  restoreRows(firstNeighbour_);
 }
 
 PositionPredictor::Features PositionPredictor::features(const Neighbourhood& around, int level) const {
@@ -157,40 +96,47 @@ PositionPredictor::Features PositionPredictor::features(const Neighbourhood& aro
   return f;
 }
 
+// The incidence lists are walked where they are: a snapshot of them in
+// contiguous rows, rebuilt twice per level, cost more time than the walk's
+// dependent loads save, and 24 bytes per triangle.
 bool PositionPredictor::gather(uint32_t vertex, Neighbourhood& around) const {
-  if (size_t(vertex) + 1 >= firstWing_.size()) return false;
+  if (vertex >= store_.vertexCapacity() || vertex >= places_.size()) return false;
   // Scalars rather than arrays: these loops, the decoder's hottest, stalled
   // on store-to-load forwarding with array temporaries.
   const double* at = places_[vertex].centre;
   const double atX = at[0], atY = at[1], atZ = at[2];
   double sumX = 0, sumY = 0, sumZ = 0, normalX = 0, normalY = 0, normalZ = 0, squared = 0;
-  const uint32_t wingCount = firstWing_[vertex + 1] - firstWing_[vertex];
-  if (wingCount > 0) {
-    // Each wing adds both its vertices (a closed fan thus counts every
-    // neighbour twice) and the cross product of their offsets.
-    const uint32_t* wing = wings_.data() + size_t(firstWing_[vertex]) * 2;
-    for (uint32_t i = 0; i < wingCount; ++i, wing += 2) {
-      const double* a = places_[wing[0]].centre;
-      const double* b = places_[wing[1]].centre;
-      const double ax = a[0] - atX, ay = a[1] - atY, az = a[2] - atZ;
-      const double bx = b[0] - atX, by = b[1] - atY, bz = b[2] - atZ;
-      sumX += ax + bx;
-      sumY += ay + by;
-      sumZ += az + bz;
-      squared += ax * ax + ay * ay + az * az + bx * bx + by * by + bz * bz;
-      normalX += ay * bz - az * by;
-      normalY += az * bx - ax * bz;
-      normalZ += ax * by - ay * bx;
-    }
-    around = {{sumX, sumY, sumZ}, {normalX, normalY, normalZ}, squared, 2 * wingCount, true};
+  uint32_t count = 0;
+  // Each triangle adds the vertex that follows this one in its winding
+  // (around a closed, consistently wound fan, every neighbour once) and the
+  // cross product of the offsets of that vertex and the next.
+  store_.forEachIncident(2, vertex, [&](uint32_t triangle, uint32_t position) {
+    static constexpr uint8_t kNext[3] = {1, 2, 0}, kAfterNext[3] = {2, 0, 1};
+    const uint32_t* tuple = store_.vertices(2, triangle);
+    // A flipped tuple winds the other way.
+    const bool flipped = store_.flags(2, triangle) & SimplexStore::kFlipped;
+    const uint32_t next = tuple[kNext[position]], afterNext = tuple[kAfterNext[position]];
+    const double* a = places_[flipped ? afterNext : next].centre;
+    const double* b = places_[flipped ? next : afterNext].centre;
+    const double ax = a[0] - atX, ay = a[1] - atY, az = a[2] - atZ;
+    const double bx = b[0] - atX, by = b[1] - atY, bz = b[2] - atZ;
+    sumX += ax;
+    sumY += ay;
+    sumZ += az;
+    squared += ax * ax + ay * ay + az * az;
+    normalX += ay * bz - az * by;
+    normalY += az * bx - ax * bz;
+    normalZ += ax * by - ay * bx;
+    ++count;
+  });
+  if (count > 0) {
+    around = {{sumX, sumY, sumZ}, {normalX, normalY, normalZ}, squared, count, true};
     return true;
   }
-  const uint32_t* neighbour = neighbours_.data() + firstNeighbour_[vertex];
-  const uint32_t count = firstNeighbour_[vertex + 1] - firstNeighbour_[vertex];
-  if (count == 0) return false;
+  // No triangle: the other ends of the edges.
   double previousX = 0, previousY = 0, previousZ = 0;  // the first cross product is zero
-  for (uint32_t i = 0; i < count; ++i) {
-    const double* centre = places_[neighbour[i]].centre;
+  store_.forEachIncident(1, vertex, [&](uint32_t edge, uint32_t position) {
+    const double* centre = places_[store_.vertices(1, edge)[1 - position]].centre;
     const double x = centre[0] - atX, y = centre[1] - atY, z = centre[2] - atZ;
     sumX += x;
     sumY += y;
@@ -209,7 +155,9 @@ bool PositionPredictor::gather(uint32_t vertex, Neighbourhood& around) const {
     previousX = x;
     previousY = y;
     previousZ = z;
-  }
+    ++count;
+  });
+  if (count == 0) return false;
   around = {{sumX, sumY, sumZ}, {normalX, normalY, normalZ}, squared, count, false};
   return true;
 }

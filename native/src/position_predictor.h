@@ -1,5 +1,5 @@
 // Geometry from connectivity: where a vertex lies, predicted from its
-// neighbours in the current complex.
+// neighbours in the complex as it is when the prediction is made.
 //
 // A one-vertex cell's split decides one bit of its vertex's coordinate along
 // the split axis; without connectivity that bit is close to a coin toss. The
@@ -65,7 +65,8 @@ int countAtMost(double t, const double (&bounds)[kCount]) {
 
 class PositionPredictor {
  public:
-  explicit PositionPredictor(const SplitSchedule& schedule);
+  // `store`: the complex the predictions read, as it changes.
+  PositionPredictor(const SplitSchedule& schedule, const SimplexStore& store);
 
   // The vertex's cell is now the one at `level` with these leading
   // coordinate bits.
@@ -74,15 +75,6 @@ class PositionPredictor {
     const std::array<double, 3>& width = widths_[size_t(level)];
     for (int a = 0; a < 3; ++a) places_[vertex].centre[a] = double(prefix[a]) * width[a] + (width[a] - 1) * 0.5;
   }
-
-  // Takes the neighbour lists of `store`'s vertices, for the predictions
-  // until the next snapshot. Call when the cells of several vertices of a
-  // geometric level start splitting (their counts are then predicted from
-  // the complex as it was at the start of the level) and again when its
-  // one-vertex cells do (the complex does not change while they split).
-  // `splits` counts the vertex splits so far: only splits change the
-  // complex, so the same count as at the last snapshot keeps the lists.
-  void snapshotNeighbours(const SimplexStore& store, uint64_t splits);
 
   // The neighbourhood class of the split of a cell of several vertices at
   // `level` whose vertex in the complex is `vertex`: for a plane through the
@@ -165,7 +157,7 @@ class PositionPredictor {
     bool outsideUp = false;  // an oriented normal points to the upper half
   };
   Features features(const Neighbourhood& around, int level) const;
-  // Sums the neighbours of `vertex` in the snapshot; false without any.
+  // Sums the neighbours of `vertex`; false without any.
   bool gather(uint32_t vertex, Neighbourhood& around) const;
   // The models of a one-vertex split: one for the joint class of all
   // features, one for the plane's alone, one for the centroid's alone,
@@ -179,14 +171,7 @@ class PositionPredictor {
   std::vector<uint8_t> axis_;                  // split axis per level
   std::vector<std::array<double, 3>> widths_;  // cell width per level and axis
   std::vector<Place> places_;
-  // At the last snapshot, per vertex (compressed rows): its triangles as
-  // "wings", the pairs of other vertices in winding order, and for vertices
-  // in no triangle, the other ends of their edges. Contiguous lists let the
-  // lookups of a vertex's neighbours proceed in parallel, where the store's
-  // linked incidence lists would chain them.
-  std::vector<uint32_t> firstWing_, wings_;
-  std::vector<uint32_t> firstNeighbour_, neighbours_;
-  uint64_t snapshotSplits_ = ~uint64_t(0);
+  const SimplexStore& store_;
   std::vector<BitModel> models_, planeModels_, centroidModels_;
   Mixer<3> mixer_;
   uint64_t countPredictions_ = 0;

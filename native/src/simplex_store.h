@@ -98,6 +98,17 @@ class SimplexStore {
       link = &pool.next[slot];
     }
   }
+  // The same walk without unlinking: killed simplices are skipped.
+  template <class Visit>
+  void forEachIncident(int dimension, uint32_t vertex, Visit&& visit) const {
+    const Pool& pool = pool_[dimension];
+    const uint32_t arity = uint32_t(dimension + 1);
+    for (uint32_t slot = heads_[dimension][vertex]; slot != kNoSimplex; slot = pool.next[slot]) {
+      const uint32_t simplex = slot / arity;
+      if (indexed_ && !(pool.flags[simplex] & kAlive)) continue;
+      visit(simplex, slot - simplex * arity);
+    }
+  }
   bool hasIncident(int dimension, uint32_t vertex) const;
   // Whether a live simplex of dimension + 1 has this simplex as a face.
   bool isFace(int dimension, uint32_t simplex) const;
