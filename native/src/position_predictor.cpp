@@ -61,6 +61,8 @@ PositionPredictor::PositionPredictor(const SplitSchedule& schedule, const Simple
   for (size_t level = 0; level < widths_.size(); ++level)
     for (int a = 0; a < 3; ++a)
       widths_[level][size_t(a)] = std::ldexp(1.0, schedule.bits[size_t(a)] - schedule.consumed[level][size_t(a)]);
+  for (size_t level = 0; level < axis_.size(); ++level)
+    inverseHalfWidths_.push_back(2.0 / widths_[level][axis_[level]]);
 }
 
 PositionPredictor::Features PositionPredictor::features(const Neighbourhood& around, int level) const {
@@ -68,11 +70,12 @@ PositionPredictor::Features PositionPredictor::features(const Neighbourhood& aro
   const int axis = axis_[size_t(level)];
   double halfWidth[3];
   for (int a = 0; a < 3; ++a) halfWidth[a] = widths_[size_t(level)][size_t(a)] * 0.5;
+  const double inverseHalfWidth = inverseHalfWidths_[size_t(level)];
   const double inverse = 1.0 / double(around.count);
   double centroid[3];  // relative to the cell centre
   for (int a = 0; a < 3; ++a) centroid[a] = around.sum[a] * inverse;
-  f.meanSquaredDistance = around.squaredDistance * inverse / (halfWidth[axis] * halfWidth[axis]);
-  f.centroidOffset = centroid[axis] / halfWidth[axis];
+  f.meanSquaredDistance = around.squaredDistance * inverse * (inverseHalfWidth * inverseHalfWidth);
+  f.centroidOffset = centroid[axis] * inverseHalfWidth;
   const double* normal = around.normal;
   const double along = std::fabs(normal[axis]) * halfWidth[axis];
   if (along > 0) {

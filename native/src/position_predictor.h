@@ -170,6 +170,10 @@ class PositionPredictor {
 
   std::vector<uint8_t> axis_;                  // split axis per level
   std::vector<std::array<double, 3>> widths_;  // cell width per level and axis
+  // Per level, 1 / half the width along the split axis: widths are powers of
+  // two, so multiplying by it rounds exactly as dividing by the half width
+  // would, without a division's latency.
+  std::vector<double> inverseHalfWidths_;
   std::vector<Place> places_;
   const SimplexStore& store_;
   std::vector<BitModel> models_, planeModels_, centroidModels_;
