@@ -10,6 +10,8 @@ namespace {
 constexpr int kScaleClasses = 5;
 constexpr int kTiltClasses = 5;  // the last: no plane
 constexpr int kOutsideClasses = 2;
+constexpr int kValenceClasses = 5;       // the last: no triangle
+constexpr int kJointValenceClasses = 3;
 constexpr int kPlaneBuckets = 6;
 constexpr int kCentroidBuckets = 10;
 
@@ -19,6 +21,15 @@ int scaleClass(double r) {
   static constexpr double kBounds[kScaleClasses - 1] = {4, 16, 64, 256};
   return countAtMost(r, kBounds);
 }
+
+// How many triangles the vertex is in (≤ 4, 5, 6, ≥ 7, or none): how far
+// its neighbourhood is from a regular fan, whose centroid lies where the
+// vertex does. The joint model takes three groups of them.
+int valenceClass(uint32_t triangles, bool inTriangles) {
+  static constexpr double kBounds[kValenceClasses - 2] = {5, 6, 7};
+  return inTriangles ? countAtMost(double(triangles), kBounds) : kValenceClasses - 1;
+}
+constexpr int kJointValence[kValenceClasses] = {0, 0, 1, 2, 2};
 
 // The plane's rise across the cell along the other axes, against its rise
 // along the split axis.
@@ -44,16 +55,19 @@ int centroidBucket(double t) {
 PositionPredictor::PositionPredictor(const SplitSchedule& schedule, const SimplexStore& store)
     : axis_(schedule.axis),
       store_(store),
-      models_(size_t(kOutsideClasses) * kScaleClasses * kTiltClasses * kPlaneBuckets * kCentroidBuckets),
+      models_(size_t(kJointValenceClasses) * kOutsideClasses * kScaleClasses * kTiltClasses * kPlaneBuckets *
+              kCentroidBuckets),
       planeModels_(size_t(kOutsideClasses) * kScaleClasses * kTiltClasses * kPlaneBuckets),
-      centroidModels_(size_t(kScaleClasses) * kCentroidBuckets),
+      centroidModels_(size_t(kValenceClasses) * kScaleClasses * kCentroidBuckets),
       // The joint model is the sharpest; the others help while it learns.
       mixer_(kScaleClasses, {39322, 19661, 19661}) {
-  static_assert(size_t(kOutsideClasses) * kScaleClasses * kTiltClasses * kPlaneBuckets * kCentroidBuckets ==
+  static_assert(size_t(kJointValenceClasses) * kOutsideClasses * kScaleClasses * kTiltClasses * kPlaneBuckets *
+                    kCentroidBuckets ==
                 kFamilySize[int(ModelFamily::OneVertexSplits)]);
   static_assert(size_t(kOutsideClasses) * kScaleClasses * kTiltClasses * kPlaneBuckets ==
                 kFamilySize[int(ModelFamily::OneVertexByPlane)]);
-  static_assert(size_t(kScaleClasses) * kCentroidBuckets == kFamilySize[int(ModelFamily::OneVertexByCentroid)]);
+  static_assert(size_t(kValenceClasses) * kScaleClasses * kCentroidBuckets ==
+                kFamilySize[int(ModelFamily::OneVertexByCentroid)]);
   primeModels(ModelFamily::OneVertexSplits, models_.data());
   primeModels(ModelFamily::OneVertexByPlane, planeModels_.data());
   primeModels(ModelFamily::OneVertexByCentroid, centroidModels_.data());
@@ -173,9 +187,13 @@ bool PositionPredictor::contextsOf(uint32_t vertex, int level, SingleContexts& c
   c.mirrored = f.mirrored;
   const int tilt = f.hasPlane ? tiltClass(f.tilt) : kTiltClasses - 1;
   const int scale = scaleClass(f.meanSquaredDistance);
+  const int valence = valenceClass(around.count, around.oriented);
+  const int centroid = centroidBucket(f.centroidOffset);
   c.plane = ((f.outsideUp * kScaleClasses + scale) * kTiltClasses + tilt) * kPlaneBuckets + planeBucket(f.planeOffset);
-  c.joint = c.plane * kCentroidBuckets + centroidBucket(f.centroidOffset);
-  c.centroid = scale * kCentroidBuckets + centroidBucket(f.centroidOffset);
+  c.joint = (kJointValence[valence] * kOutsideClasses * kScaleClasses * kTiltClasses * kPlaneBuckets + c.plane) *
+                kCentroidBuckets +
+            centroid;
+  c.centroid = (valence * kScaleClasses + scale) * kCentroidBuckets + centroid;
   c.mixerSet = scale;
   return true;
 }

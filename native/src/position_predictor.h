@@ -23,7 +23,9 @@
 //     larger than the gaps between neighbours and predict little);
 //   - whether the outside lies towards the predicted half (surfaces curve
 //     away from their outside more often than not, so a vertex sits on the
-//     outer side of its neighbours' plane).
+//     outer side of its neighbours' plane);
+//   - how many triangles the vertex is in (a regular fan's centroid is a
+//     better guess than an irregular one's).
 // The configuration is mirrored so that the prediction points to the upper
 // half, which lets the two mirror images share statistics. A one-vertex split
 // mixes three models chosen by these features (mixer.h); the split of a cell
