@@ -167,7 +167,6 @@ struct Decoder::State {
     return Status::success();
   }
 
-
   // Returns false on connectivity codes that contradict each other.
   bool splitCell(const Cell& cell) {
     const uint32_t population = cell.population;

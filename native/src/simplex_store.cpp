@@ -135,28 +135,19 @@ void SimplexStore::replaceVertex(int dimension, uint32_t simplex, uint32_t from,
 }
 
 bool SimplexStore::hasIncident(int dimension, uint32_t vertex) const {
-  const Pool& pool = pool_[dimension];
-  const uint32_t arity = uint32_t(dimension + 1);
-  for (uint32_t slot = heads_[dimension][vertex]; slot != kNoSimplex; slot = pool.next[slot])
-    if (pool.flags[slot / arity] & kAlive) return true;
-  return false;
+  return forEachIncident(dimension, vertex, [](uint32_t, uint32_t) { return true; });
 }
 
 bool SimplexStore::isFace(int dimension, uint32_t simplex) const {
   if (dimension >= kMaxDimension) return false;
   const uint32_t* mine = vertices(dimension, simplex);
-  const Pool& higher = pool_[dimension + 1];
-  const uint32_t arity = uint32_t(dimension + 2);
-  for (uint32_t slot = heads_[dimension + 1][mine[0]]; slot != kNoSimplex; slot = higher.next[slot]) {
-    const uint32_t candidate = slot / arity;
-    if (!(higher.flags[candidate] & kAlive)) continue;
-    const uint32_t* theirs = &higher.vertices[size_t(candidate) * arity];
+  const int arity = dimension + 2;
+  return forEachIncident(dimension + 1, mine[0], [&](uint32_t candidate, uint32_t) {
+    const uint32_t* theirs = vertices(dimension + 1, candidate);
     bool all = true;
-    for (int i = 1; i <= dimension && all; ++i)
-      all = std::find(theirs, theirs + arity, mine[i]) != theirs + arity;
-    if (all) return true;
-  }
-  return false;
+    for (int i = 1; i <= dimension && all; ++i) all = std::find(theirs, theirs + arity, mine[i]) != theirs + arity;
+    return all;
+  });
 }
 
 void SimplexStore::link(int dimension, uint32_t simplex, uint32_t position) {

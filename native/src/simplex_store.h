@@ -14,6 +14,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <type_traits>
 #include <vector>
 
 namespace kdmesh {
@@ -58,6 +59,8 @@ class SimplexStore {
   // Index of the live simplex with this vertex set, or kNoSimplex (indexed
   // stores only).
   uint32_t find(int dimension, const uint32_t* vertices) const;
+  // Indexed stores only: the walks of an unindexed store (the decoder's)
+  // do not look at the flags, since nothing is killed there.
   void kill(int dimension, uint32_t simplex);
   // Replaces vertex `from` of a simplex by `to` (which it must not contain),
   // keeping the orientation. Lists are left alone: the split and merge
@@ -98,16 +101,23 @@ class SimplexStore {
       link = &pool.next[slot];
     }
   }
-  // The same walk without unlinking: killed simplices are skipped.
+  // The same walk without unlinking: killed simplices are skipped. A
+  // visitor that returns a bool ends the walk by returning true, and the
+  // walk then returns true.
   template <class Visit>
-  void forEachIncident(int dimension, uint32_t vertex, Visit&& visit) const {
+  bool forEachIncident(int dimension, uint32_t vertex, Visit&& visit) const {
     const Pool& pool = pool_[dimension];
     const uint32_t arity = uint32_t(dimension + 1);
     for (uint32_t slot = heads_[dimension][vertex]; slot != kNoSimplex; slot = pool.next[slot]) {
       const uint32_t simplex = slot / arity;
       if (indexed_ && !(pool.flags[simplex] & kAlive)) continue;
-      visit(simplex, slot - simplex * arity);
+      if constexpr (std::is_same_v<decltype(visit(simplex, 0u)), bool>) {
+        if (visit(simplex, slot - simplex * arity)) return true;
+      } else {
+        visit(simplex, slot - simplex * arity);
+      }
     }
+    return false;
   }
   bool hasIncident(int dimension, uint32_t vertex) const;
   // Whether a live simplex of dimension + 1 has this simplex as a face.
