@@ -3,7 +3,10 @@
 // same model loaded with three.js's DRACOLoader (whose first render is its
 // full download plus decode). Also lists main-thread long tasks.
 //
-//   node bench/browser-bench.mjs [--throttle KBPS]
+//   node bench/browser-bench.mjs [--throttle KBPS] [--runs N]
+//
+// With several runs, one row per run and a summary: long tasks are rare
+// events, and one clean run says little.
 import { execFileSync } from 'node:child_process';
 import { mkdtempSync } from 'node:fs';
 import { tmpdir } from 'node:os';
@@ -12,8 +15,12 @@ import { chromium } from 'playwright-core';
 import { startServer } from '../web/server.mjs';
 
 const root = new URL('..', import.meta.url).pathname;
-const throttleAt = process.argv.indexOf('--throttle');
-const throttle = throttleAt > 0 ? Number(process.argv[throttleAt + 1]) : 10000;
+function option(name, fallback) {
+  const at = process.argv.indexOf(name);
+  return at > 0 ? Number(process.argv[at + 1]) : fallback;
+}
+const throttle = option('--throttle', 10000);
+const runs = option('--runs', 1);
 const models = mkdtempSync(join(tmpdir(), 'kdmesh-browser-bench-'));
 const dragon = join(root, 'build', 'models', 'dragon_vrip.ply');
 execFileSync(join(root, 'build', 'kdmesh'), ['encode', dragon, '-o', join(models, 'dragon.kdm'), '--bits', '12', '-q']);
@@ -35,19 +42,37 @@ async function run(url, done, read) {
   return result;
 }
 
-const kdmesh = await run(`${base}/?model=dragon.kdm&throttle=${throttle}`,
-  () => window.kdmeshViewer.state === 'error' || window.kdmeshViewer.finalRenderMs !== null,
-  () => ({ ...window.kdmeshViewer }));
-const draco = await run(`${base}/draco-bench.html?model=models/dragon.drc%3Fthrottle%3D${throttle}`,
-  () => window.dracoBench.state === 'complete',
-  () => ({ ...window.dracoBench }));
+const ms = (v) => (v === null ? '–' : `${(v / 1000).toFixed(2)} s`);
+const row = (name, first, final, refinements, tasks) =>
+  `| ${name} | ${ms(first)} | ${ms(final)} | ${refinements} | ${Math.max(0, ...tasks)} ms | ${tasks.length} |`;
+console.log(`| dragon at ${throttle / 1000} Mbit/s | first render | final render | refinements | longest main-thread task | long tasks (> 50 ms) |`);
+console.log('|---|---:|---:|---:|---:|---:|');
+const all = { kdmesh: [], draco: [] };
+for (let i = 1; i <= runs; ++i) {
+  const kdmesh = await run(`${base}/?model=dragon.kdm&throttle=${throttle}`,
+    () => window.kdmeshViewer.state === 'error' || window.kdmeshViewer.finalRenderMs !== null,
+    () => ({ ...window.kdmeshViewer }));
+  const draco = await run(`${base}/draco-bench.html?model=models/dragon.drc%3Fthrottle%3D${throttle}`,
+    () => window.dracoBench.state === 'complete',
+    () => ({ ...window.dracoBench }));
+  const run_ = runs > 1 ? `, run ${i}` : '';
+  console.log(row(`kdmesh (.kdm, progressive)${run_}`, kdmesh.firstRenderMs, kdmesh.finalRenderMs, kdmesh.refinements, kdmesh.longTasks));
+  console.log(row(`three.js DRACOLoader (.drc -cl 10)${run_}`, draco.renderMs, draco.renderMs, 1, draco.longTasks));
+  all.kdmesh.push(kdmesh);
+  all.draco.push(draco);
+}
 await browser.close();
 server.close();
 
-const ms = (v) => (v === null ? '–' : `${(v / 1000).toFixed(2)} s`);
-console.log(`| dragon at ${throttle / 1000} Mbit/s | first render | final render | refinements | longest main-thread task | long tasks (> 50 ms) |`);
-console.log('|---|---:|---:|---:|---:|---:|');
-console.log(`| kdmesh (.kdm, progressive) | ${ms(kdmesh.firstRenderMs)} | ${ms(kdmesh.finalRenderMs)} | ${kdmesh.refinements} | ` +
-  `${Math.max(0, ...kdmesh.longTasks)} ms | ${kdmesh.longTasks.length} |`);
-console.log(`| three.js DRACOLoader (.drc -cl 10) | ${ms(draco.renderMs)} | ${ms(draco.renderMs)} | 1 | ` +
-  `${Math.max(0, ...draco.longTasks)} ms | ${draco.longTasks.length} |`);
+if (runs > 1) {
+  const median = (values) => values.sort((a, b) => a - b)[values.length >> 1];
+  const summary = (name, results, first, final) => {
+    const withTasks = results.filter((r) => r.longTasks.length > 0).length;
+    const longest = Math.max(0, ...results.flatMap((r) => r.longTasks));
+    console.log(`${name}: first render median ${ms(median(results.map(first)))}, final render median ` +
+      `${ms(median(results.map(final)))}; runs with a main-thread task over 50 ms: ${withTasks} of ${results.length}` +
+      ` (longest ${longest} ms)`);
+  };
+  summary('kdmesh', all.kdmesh, (r) => r.firstRenderMs, (r) => r.finalRenderMs);
+  summary('DRACOLoader', all.draco, (r) => r.renderMs, (r) => r.renderMs);
+}

@@ -82,7 +82,7 @@ echo
 if [ "$quick" = 0 ]; then
   echo "## Viewer: time to first and final render (headless chromium, SwiftShader)"
   echo
-  node bench/browser-bench.mjs --throttle 10000
+  node bench/browser-bench.mjs --throttle 10000 --runs 5
   echo
 fi
 
