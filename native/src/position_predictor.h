@@ -110,6 +110,7 @@ class PositionPredictor {
   }
 
   bool geometric(int level) const { return size_t(level) < axis_.size(); }
+  double inverseHalfWidth(int level) const { return inverseHalfWidths_[size_t(level)]; }
 
   // The split axis of a geometric `level`, and the centre of a vertex's
   // current cell in grid units.

@@ -67,7 +67,12 @@ struct StarEntry {
   uint8_t code;
   uint8_t record;
   uint8_t geometry;  // edges: class of the other vertex's direction (see classifyEdges)
+  bool mirrored;     // edges: codes 1 and 2 swap places in the coding (see classifyEdges)
   uint8_t fanCodes;  // edges: codes already given to fan neighbours, bits 0 (1), 1 (2), 2 (3 or 4)
+  // Cut edges (coded 3 or 4): how many triangles through them were coded 4,
+  // and how many between them and another cut edge are still to be coded.
+  uint8_t addedTriangles;
+  uint16_t pairedTriangles;
   // Edges: star indices of two edges sharing a triangle with this one;
   // triangles: of their two edges through the vertex. kNoSimplex if none.
   uint32_t links[2];
@@ -91,8 +96,8 @@ class VertexSplitter {
     static_assert(sizeof(edgeDirectionModels_) / sizeof(BitModel) ==
                   kFamilySize[int(ModelFamily::EdgeCodesByDirection)]);
     primeModels(ModelFamily::EdgeCodesByDirection, edgeDirectionModels());
-    static_assert(sizeof(triangleModels_) / sizeof(BitModel) == kFamilySize[int(ModelFamily::TriangleCodes)]);
-    primeModels(ModelFamily::TriangleCodes, triangleModels());
+    static_assert(sizeof(triangleModels_[0]) / sizeof(BitModel) == kFamilySize[int(ModelFamily::TriangleCodes)]);
+    for (auto& models : triangleModels_) primeModels(ModelFamily::TriangleCodes, &models[0][0][0]);
   }
 
   // Splits `v`, whose cell is at `level`, into `v` and `v2`. `next()` of the
@@ -105,7 +110,7 @@ class VertexSplitter {
   const ConnectivityStatistics& statistics() const { return statistics_; }
   BitModel* edgeModels() { return &edgeModels_[0][0][0][0][0]; }
   BitModel* edgeDirectionModels() { return &edgeDirectionModels_[0][0][0]; }
-  BitModel* triangleModels() { return &triangleModels_[0][0][0]; }
+  BitModel* triangleModels() { return &triangleModels_[0][0][0][0]; }
 
  private:
   using Entry = StarEntry;
@@ -118,6 +123,10 @@ class VertexSplitter {
   void classifyEdges(uint32_t v, int level);
   void orderCodes(bool geometric);
   void linkFans();
+  size_t countPairedTriangles();
+  static constexpr int kUnpaired = 0x7fffffff;
+  int pairingSlack(const Entry& triangle) const;
+  void takeMostConstrainedTriangle(size_t step);
   int triangleClass(const Entry& triangle) const;
   template <class Coder>
   uint8_t codeSymbol(Coder& coder, BitModel (&models)[3], uint8_t possible, uint8_t code,
@@ -132,7 +141,13 @@ class VertexSplitter {
   const PositionPredictor& geometry_;
   std::vector<Entry> star_;
   std::vector<double> cosines_;
+  std::vector<double> reaches_;  // edge lengths in half widths of the cell along the split axis
   std::vector<uint32_t> codingOrder_;  // star_ indices in the order codes are taken
+  // When some edge of the star has more than two fan neighbours (its links
+  // hold two), the fan neighbours of every edge (star_ indices): those of
+  // the edge begin_[1] + e are fanList_[fanStart_[e] .. fanStart_[e + 1]).
+  bool crowdedFans_ = false;
+  std::vector<uint32_t> fanStart_, fanList_, fanFill_;
   std::array<size_t, 5> begin_{};  // star_ entries of dimension d: [begin_[d], begin_[d+1])
   // Simplices of dimension d at v or v2 after the split, gathered on the
   // first orientation decision of that dimension (most splits of a surface
@@ -142,11 +157,11 @@ class VertexSplitter {
   const std::vector<uint32_t>& around(int dimension);
   // Code models: [dimension][possible set][step of the sequential binarisation].
   BitModel codeModels_[4][16][3];
-  // Triangles at geometric levels: [class of their two other vertices'
-  // directions][possible set][step] (what separates a tetrahedral mesh's
-  // star in two).
+  // Triangles at geometric levels: [pairing class (see split())][class of
+  // their two other vertices' directions][possible set][step] (what
+  // separates a tetrahedral mesh's star in two).
   static constexpr int kTriangleClasses = 18;
-  BitModel triangleModels_[kTriangleClasses][16][3];
+  BitModel triangleModels_[3][kTriangleClasses][16][3];
   static constexpr int kEdgeClasses = 25;
   // Edges: [cut edges so far][fan codes][class][all four codes possible]
   // (an edge's only face is the vertex, coded 3 or 4, so it has two sets).
@@ -211,7 +226,14 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, Ora
   // The encoder's records come in canonical order.
   for (Entry& entry : star_) entry.record = oracle();
   orderCodes(geometric);
-  for (const uint32_t index : codingOrder_) {
+  size_t pairedTriangles = 0;
+  const size_t orderedTriangles = geometric ? begin_[3] - begin_[2] : 0;
+  for (size_t step = 0; step < codingOrder_.size(); ++step) {
+    if (step - begin_[2] < orderedTriangles) {  // unsigned: a triangle at a geometric level
+      if (step == begin_[2]) pairedTriangles = countPairedTriangles();
+      if (pairedTriangles > 0) takeMostConstrainedTriangle(step);
+    }
+    const uint32_t index = codingOrder_[step];
     Entry& entry = star_[index];
     const uint8_t possible = possibleCodes(entry);
     if (possible == 0) return false;
@@ -219,14 +241,42 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, Ora
     if (entry.dimension == 1) {
       const bool all = possible == 0b1111;
       const int cut = std::min(cutEdges, 2);
-      entry.code = codeSymbol(coder, edgeModels_[cut][entry.fanCodes][entry.geometry][all], possible, code,
-                              edgeDirectionModels_[entry.geometry][all], cut);
+      // Codes 1 and 2 (bits 0 and 1 of code sets) trade places in a
+      // mirrored edge's coding.
+      const bool mirrored = entry.mirrored;
+      auto mirrorSet = [mirrored](uint8_t set) {
+        return mirrored ? uint8_t((set & ~3u) | (set & 1u) << 1 | (set >> 1 & 1u)) : set;
+      };
+      auto mirrorCode = [mirrored](uint8_t c) { return mirrored && c <= 2 ? uint8_t(3 - c) : c; };
+      entry.code = mirrorCode(codeSymbol(coder, edgeModels_[cut][mirrorSet(entry.fanCodes)][entry.geometry][all],
+                                         mirrorSet(possible), mirrorCode(code),
+                                         edgeDirectionModels_[entry.geometry][all], cut));
       cutEdges += entry.code == 4;
       const uint8_t bit = uint8_t(1u << std::min(entry.code - 1, 2));
-      for (const uint32_t neighbour : entry.links)
-        if (neighbour != kNoSimplex) star_[neighbour].fanCodes |= bit;
+      if (crowdedFans_) {
+        const size_t edge = index - begin_[1];
+        for (uint32_t k = fanStart_[edge]; k < fanStart_[edge + 1]; ++k) star_[fanList_[k]].fanCodes |= bit;
+      } else {
+        for (const uint32_t neighbour : entry.links)
+          if (neighbour != kNoSimplex) star_[neighbour].fanCodes |= bit;
+      }
     } else if (entry.dimension == 2 && geometric) {
-      entry.code = codeSymbol(coder, triangleModels_[triangleClass(entry)][possible], possible, code);
+      // Here the triangle has both its edges through v (else
+      // possibleCodes() returned 0).
+      Entry& first = star_[entry.links[0]];
+      Entry& second = star_[entry.links[1]];
+      const int slack = pairedTriangles > 0 ? pairingSlack(entry) : kUnpaired;
+      const bool paired = slack != kUnpaired;
+      const int pairing = !paired || slack > 0 ? 0 : first.addedTriangles >= 2 || second.addedTriangles >= 2 ? 1 : 2;
+      if (paired) {
+        --first.pairedTriangles;
+        --second.pairedTriangles;
+      }
+      entry.code = codeSymbol(coder, triangleModels_[pairing][triangleClass(entry)][possible], possible, code);
+      if (entry.code == 4) {
+        ++first.addedTriangles;
+        ++second.addedTriangles;
+      }
     } else {
       entry.code = codeSymbol(coder, codeModels_[entry.dimension][possible], possible, code);
     }
