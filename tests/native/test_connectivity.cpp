@@ -63,9 +63,13 @@ TEST(Connectivity, PredictorsRunAlikeOnBothSides) {
     EXPECT_EQ(theirs.countPredictions, mine.countPredictions);
     EXPECT_EQ(theirs.positionPredictions, mine.positionPredictions);
     EXPECT_EQ(theirs.edgeExpansions, mine.edgeExpansions);
-    // Surfaces split mostly by edge expansions.
+    EXPECT_EQ(theirs.pairedTriangles, mine.pairedTriangles);
+    // Surfaces split mostly by edge expansions; tetrahedral meshes have
+    // triangles between cut edges.
     if (c.surface) {
       EXPECT_GT(mine.edgeExpansions * 2, mine.vertexSplits);
+    } else {
+      EXPECT_GT(mine.pairedTriangles, 0u);
     }
   }
 }
