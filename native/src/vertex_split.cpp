@@ -151,7 +151,7 @@ void VertexSplitter::classifyEdges(uint32_t v, int level) {
   // plane's patch between v and v2 (tetrahedral ball: −0.7 bits per vertex
   // against the crossing class).
   const bool volume = begin_[4] > begin_[3];
-  reaches_.resize(last - first);
+  if (volume) reaches_.resize(last - first);
   statistics_.edgeCodesByDirection += last - first;
   const int axis = geometry_.axis(level);
   double from[3];
@@ -165,7 +165,7 @@ void VertexSplitter::classifyEdges(uint32_t v, int level) {
     }
     const double length = std::sqrt(squared);
     cosines_[i - first] = squared > 0 ? to[axis] / length : 0;
-    reaches_[i - first] = length * geometry_.inverseHalfWidth(level);
+    if (volume) reaches_[i - first] = length * geometry_.inverseHalfWidth(level);
   }
   for (size_t i = first; i < last; ++i) {
     const double cosine = cosines_[i - first], magnitude = std::fabs(cosine);
@@ -362,15 +362,14 @@ int VertexSplitter::voteOnFlip(uint32_t simplex, const std::vector<uint32_t>& ca
   for (const uint32_t other : candidates) {
     if (other == simplex || (store_.flags(kDimension, other) & SimplexStore::kUndecided)) continue;
     const uint32_t* theirs = store_.vertices(kDimension, other);
-    // Neighbours share all vertices but one each.
+    // Neighbours share all vertices but one each; most candidates share
+    // only the split's vertex, so theirs are looked at only after mine.
     int mineShared = 0, theirsShared = 0;  // bit i: vertex i is in the other
-    for (int i = 0; i < kArity; ++i) {
-      mineShared |= int(containsVertex(theirs, kArity, mine[i])) << i;
-      theirsShared |= int(containsVertex(mine, kArity, theirs[i])) << i;
-    }
+    for (int i = 0; i < kArity; ++i) mineShared |= int(containsVertex(theirs, kArity, mine[i])) << i;
     constexpr int kAll = (1 << kArity) - 1;
     const int mineOnly = kAll ^ mineShared;
     if (mineOnly & (mineOnly - 1) || mineOnly == 0) continue;  // not exactly one vertex apart
+    for (int i = 0; i < kArity; ++i) theirsShared |= int(containsVertex(mine, kArity, theirs[i])) << i;
     const int theirsOnly = kAll ^ theirsShared;
     // Orientation each induces on the shared facet; consistent neighbours
     // induce opposite ones.
