@@ -237,6 +237,8 @@ int VertexSplitter::pairingSlack(const Entry& triangle) const {
 // Brings the most constrained of the triangles still to be coded to
 // codingOrder_[step]: each code-4 decision there tightens the others
 // (tetrahedral ball: triangle codes −8 % against the canonical order).
+// split() stops calling it once the paired triangles are coded (the rest
+// keep their order), so a split costs O(paired × triangles) here.
 void VertexSplitter::takeMostConstrainedTriangle(size_t step) {
   size_t best = step;
   int bestSlack = pairingSlack(star_[codingOrder_[step]]);

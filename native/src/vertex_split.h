@@ -271,6 +271,7 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, Ora
       if (paired) {
         --first.pairedTriangles;
         --second.pairedTriangles;
+        --pairedTriangles;  // the search for the next ends with the last
         ++statistics_.pairedTriangles;
       }
       entry.code = codeSymbol(coder, triangleModels_[pairing][triangleClass(entry)][possible], possible, code);
