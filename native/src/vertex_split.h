@@ -21,7 +21,10 @@
 // At geometric levels the split is known to separate V1 and V2 along the
 // split axis, so edges and triangles are coded by where their other
 // vertices lie against the split plane, and edges also by the codes already
-// given to their fan neighbours (docs/FORMAT.md).
+// given to their fan neighbours (docs/FORMAT.md). In a tetrahedral star the
+// cut edges form the link of the new edge v v2, a cycle: each has two
+// triangles coded 4, which makes the triangles between cut edges cheap
+// when the most constrained of them are taken first.
 //
 // Triangles and tetrahedra are oriented. A child that inherits its parent's
 // tuple keeps the parent's orientation; the second copy of a code-3 simplex
@@ -267,6 +270,8 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, Ora
       Entry& second = star_[entry.links[1]];
       const int slack = pairedTriangles > 0 ? pairingSlack(entry) : kUnpaired;
       const bool paired = slack != kUnpaired;
+      // Pairing class: 1 when an edge has its two code-4 triangles, 2 when
+      // an edge needs every candidate it has left, 0 otherwise.
       const int pairing = !paired || slack > 0 ? 0 : first.addedTriangles >= 2 || second.addedTriangles >= 2 ? 1 : 2;
       if (paired) {
         --first.pairedTriangles;
