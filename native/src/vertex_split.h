@@ -120,6 +120,13 @@ class VertexSplitter {
 
   // Possible codes as a bit set: bit c-1 for code c.
   static constexpr uint8_t kAllowedBy[5] = {0, 0b0001, 0b0010, 0b0111, 0b1111};
+  // Mirrored coding: codes 1 and 2 (bits 0 and 1 of code sets) trade places.
+  static uint8_t mirrorSet(uint8_t set, bool mirrored) {
+    return mirrored ? uint8_t((set & ~3u) | (set & 1u) << 1 | (set >> 1 & 1u)) : set;
+  }
+  static uint8_t mirrorCode(uint8_t code, bool mirrored) {
+    return mirrored && code <= 2 ? uint8_t(3 - code) : code;
+  }
 
   uint8_t possibleCodes(const Entry& entry) const;
   const Entry* findFace(int dimension, const uint32_t* others) const;
@@ -244,16 +251,12 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, Ora
     if (entry.dimension == 1) {
       const bool all = possible == 0b1111;
       const int cut = std::min(cutEdges, 2);
-      // Codes 1 and 2 (bits 0 and 1 of code sets) trade places in a
-      // mirrored edge's coding.
       const bool mirrored = entry.mirrored;
-      auto mirrorSet = [mirrored](uint8_t set) {
-        return mirrored ? uint8_t((set & ~3u) | (set & 1u) << 1 | (set >> 1 & 1u)) : set;
-      };
-      auto mirrorCode = [mirrored](uint8_t c) { return mirrored && c <= 2 ? uint8_t(3 - c) : c; };
-      entry.code = mirrorCode(codeSymbol(coder, edgeModels_[cut][mirrorSet(entry.fanCodes)][entry.geometry][all],
-                                         mirrorSet(possible), mirrorCode(code),
-                                         edgeDirectionModels_[entry.geometry][all], cut));
+      entry.code = mirrorCode(
+          codeSymbol(coder, edgeModels_[cut][mirrorSet(entry.fanCodes, mirrored)][entry.geometry][all],
+                     mirrorSet(possible, mirrored), mirrorCode(code, mirrored),
+                     edgeDirectionModels_[entry.geometry][all], cut),
+          mirrored);
       cutEdges += entry.code == 4;
       const uint8_t bit = uint8_t(1u << std::min(entry.code - 1, 2));
       if (crowdedFans_) {
@@ -279,7 +282,14 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, Ora
         --pairedTriangles;  // the search for the next ends with the last
         ++statistics_.pairedTriangles;
       }
-      entry.code = codeSymbol(coder, triangleModels_[pairing][triangleClass(entry)][possible], possible, code);
+      // A triangle whose two other vertices lie in v2's half is coded
+      // mirrored (the class does not say which half).
+      const bool mirrored =
+          cosines_[entry.links[0] - begin_[1]] > 0 && cosines_[entry.links[1] - begin_[1]] > 0;
+      const uint8_t possibleHere = mirrorSet(possible, mirrored);
+      entry.code = mirrorCode(codeSymbol(coder, triangleModels_[pairing][triangleClass(entry)][possibleHere],
+                                         possibleHere, mirrorCode(code, mirrored)),
+                              mirrored);
       if (entry.code == 4) {
         ++first.addedTriangles;
         ++second.addedTriangles;
