@@ -131,6 +131,12 @@ uint8_t VertexSplitter::possibleCodes(const Entry& entry) const {
   return possible;
 }
 
+// The bucket of an edge's |cos| against the split axis (< 0.2, 0.45, 0.7, ≥ 0.7).
+static int directionBucket(double cosine) {
+  static constexpr double kBounds[3] = {0.2, 0.45, 0.7};
+  return countAtMost(std::fabs(cosine), kBounds);
+}
+
 // Where each edge's other vertex lies against the split: the cosine of the
 // angle between the split axis and the direction from v's cell centre to
 // it. Negative cosines point to v's half, positive ones to v2's; the two
@@ -145,17 +151,16 @@ void VertexSplitter::classifyEdges(uint32_t v, int level) {
     return;
   }
   cosines_.resize(last - first);
+  statistics_.edgeCodesByDirection += last - first;
+  const int axis = geometry_.axis(level);
+  double from[3];
+  geometry_.centreOf(v, from);
   // In a tetrahedral mesh an edge has many fan neighbours and no crossing
   // to speak of; what tells a cut edge there is its length against the
   // cell: a neighbour within a cell width or so of v lies near the split
   // plane's patch between v and v2 (tetrahedral ball: −0.7 bits per vertex
   // against the crossing class).
   const bool volume = begin_[4] > begin_[3];
-  if (volume) reaches_.resize(last - first);
-  statistics_.edgeCodesByDirection += last - first;
-  const int axis = geometry_.axis(level);
-  double from[3];
-  geometry_.centreOf(v, from);
   for (size_t i = first; i < last; ++i) {
     double to[3], squared = 0;
     geometry_.centreOf(star_[i].others[0], to);
@@ -165,34 +170,27 @@ void VertexSplitter::classifyEdges(uint32_t v, int level) {
     }
     const double length = std::sqrt(squared);
     cosines_[i - first] = squared > 0 ? to[axis] / length : 0;
-    if (volume) reaches_[i - first] = length * geometry_.inverseHalfWidth(level);
+    if (volume) {
+      // Length in half widths of the cell along the split axis.
+      static constexpr double kReachBounds[2] = {2, 3};
+      const int reach = countAtMost(length * geometry_.inverseHalfWidth(level), kReachBounds);
+      star_[i].geometry = uint8_t(1 + reach * 8 + directionBucket(cosines_[i - first]));
+    }
   }
+  if (volume) return;
   for (size_t i = first; i < last; ++i) {
     const double cosine = cosines_[i - first], magnitude = std::fabs(cosine);
-    static constexpr double kBounds[3] = {0.2, 0.45, 0.7};
-    const int bucket = countAtMost(magnitude, kBounds);
-    int neighbourhood = 0;
-    if (volume) {
-      // In half widths of the cell along the split axis.
-      static constexpr double kReachBounds[2] = {2, 3};
-      neighbourhood = countAtMost(reaches_[i - first], kReachBounds);
-      // Its codes are coded mirrored when it lies on v2's side: the two
-      // sides share statistics (tetrahedral ball: −0.08 bits per vertex;
-      // surfaces lose by it, their split is not symmetric enough).
-      star_[i].mirrored = cosine > 0;
-      star_[i].geometry = uint8_t(1 + neighbourhood * 8 + bucket);
-      continue;
-    }
     // Between a fan neighbour on v's side and one on v2's side lies a cut
     // edge: likely the one of the two closer to the split plane.
+    int crossing = 0;
     for (const uint32_t neighbour : star_[i].links) {
       if (neighbour == kNoSimplex) continue;
       const double theirs = cosines_[neighbour - first];
       if ((theirs > 0) == (cosine > 0)) continue;
-      neighbourhood = magnitude <= std::fabs(theirs) ? 1 : std::max(neighbourhood, 2);
-      if (neighbourhood == 1) break;
+      crossing = magnitude <= std::fabs(theirs) ? 1 : std::max(crossing, 2);
+      if (crossing == 1) break;
     }
-    star_[i].geometry = uint8_t(1 + (neighbourhood * 2 + (cosine > 0)) * 4 + bucket);
+    star_[i].geometry = uint8_t(1 + (crossing * 2 + (cosine > 0)) * 4 + directionBucket(cosine));
   }
 }
 
@@ -271,13 +269,13 @@ void VertexSplitter::orderCodes(bool geometric) {
 
 // Edges of the star that share a triangle are fan neighbours: around a
 // manifold vertex the codes run 1...1 4 2...2 4 along the fan, so the codes
-// already given to an edge's fan neighbours say much about its own. Two
-// neighbours per edge are kept (a manifold fan has no more).
+// already given to an edge's fan neighbours say much about its own. Each
+// edge links the first two (a manifold fan has no more); the full lists
+// are made only for stars where some edge has more.
 void VertexSplitter::linkFans() {
   for (size_t i = begin_[1]; i < begin_[3]; ++i) {
     star_[i].fanCodes = star_[i].addedTriangles = 0;
     star_[i].pairedTriangles = 0;
-    star_[i].mirrored = false;
     star_[i].links[0] = star_[i].links[1] = kNoSimplex;
   }
   crowdedFans_ = false;
