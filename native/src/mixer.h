@@ -20,14 +20,18 @@ class Logistic {
   static constexpr int squash(int d) {
     if (d > 2047) d = 2047;
     if (d < -2047) d = -2047;
-    // 4096 / (1 + e^(-d/256)) at d = -2048, -1920, ..., 2048, rounded.
-    constexpr int kKnots[33] = {1,    2,    4,    6,    10,   17,   27,   45,   74,   120,  194,
-                                311,  488,  747,  1102, 1546, 2048, 2550, 2994, 3349, 3608, 3785,
-                                3902, 3976, 4022, 4051, 4069, 4079, 4086, 4090, 4092, 4094, 4095};
     const int i = (d + 2048) >> 7, w = (d + 2048) & 127;
     return (kKnots[i] * (128 - w) + kKnots[i + 1] * w + 64) >> 7;
   }
   static int stretch(int p);
+
+ private:
+  // 4096 / (1 + e^(-d/256)) at d = -2048, -1920, ..., 2048, rounded. A
+  // static member: a table local to squash() was rebuilt on the stack at
+  // every call.
+  static constexpr int kKnots[33] = {1,    2,    4,    6,    10,   17,   27,   45,   74,   120,  194,
+                                     311,  488,  747,  1102, 1546, 2048, 2550, 2994, 3349, 3608, 3785,
+                                     3902, 3976, 4022, 4051, 4069, 4079, 4086, 4090, 4092, 4094, 4095};
 };
 
 // The inverse of squash: for each p, the smallest d with squash(d) >= p.

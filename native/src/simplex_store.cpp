@@ -100,14 +100,19 @@ uint32_t SimplexStore::add(int dimension, const uint32_t* vertices, uint8_t flag
   // Slots are simplex * arity + position in 32 bits.
   if (simplex >= pool.capacity || simplex >= 0xfffffff0u / arity) return kNoSimplex;
   pool.vertices.insert(pool.vertices.end(), vertices, vertices + arity);
-  pool.next.resize(pool.next.size() + arity);
   pool.flags.push_back(uint8_t(flags | kAlive));
   ++live_[dimension];
   if (indexed_) {
     if (size_t(live_[dimension]) * 2 > pool.table.size()) grow(dimension);
     insertIndex(dimension, simplex);
   }
-  for (uint32_t i = 0; i < arity; ++i) link(dimension, simplex, i);
+  // Linked as link() does, each slot's successor pushed rather than set
+  // after a resize (the decoder's third most frequent call).
+  std::vector<uint32_t>& heads = heads_[dimension];
+  for (uint32_t i = 0; i < arity; ++i) {
+    pool.next.push_back(heads[vertices[i]]);
+    heads[vertices[i]] = simplex * uint32_t(arity) + i;
+  }
   return simplex;
 }
 
