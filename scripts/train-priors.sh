@@ -4,7 +4,10 @@
 # fandisk or bunny), and rewrites native/src/model_priors.inc. The priors are
 # part of the stream format: bump kFormatVersion when they change.
 #
-#   sh scripts/train-priors.sh
+#   sh scripts/train-priors.sh [--only NAMES]
+#
+# Learning starts from the priors compiled in; --only retrains the named
+# arrays of model_priors.inc (comma-separated) and keeps the others.
 set -eu
 cd "$(dirname "$0")/.."
 sh scripts/build.sh >/dev/null
@@ -17,5 +20,5 @@ for name in elephant camel cow bull dino elk couplingdown armadillo ChineseDrago
   meshes="$meshes $dir/$name.off"
 done
 # shellcheck disable=SC2086
-./build/kdmesh_train_priors native/src/model_priors.inc $meshes
+./build/kdmesh_train_priors "$@" native/src/model_priors.inc $meshes
 echo "wrote native/src/model_priors.inc; rebuild to use it"

@@ -7,9 +7,11 @@
 //   - the kd-tree level (cell size relative to the sampling density),
 //   - whether the parent split sent all its vertices to one side, and
 //   - the node of the bisection tree (the decisions taken so far),
-//   - and, for populations up to 15 in a complex, a class of the cell's
-//     neighbourhood (PositionPredictor::countContext), whose model is mixed
-//     with the one above.
+//   - and, in a complex, a class of the cell's neighbourhood
+//     (PositionPredictor::countContext), whose model is mixed with the one
+//     above. Populations above 15 share one model per class and tree node:
+//     few cells are that large, and each population's own models learned
+//     too slowly to pay (bunny −0.05 bits per vertex with them shared).
 // After six decisions the few remaining candidates of a large cell are nearly
 // equiprobable and are coded uniformly.
 #pragma once
@@ -41,7 +43,7 @@ class CountCoder {
   CountCoder(int levels, bool neighbourhoods)
       : levels_(levels < 1 ? 1 : levels), mixer_(kNeighbourhoodClasses, {45875, 19661}) {
     models_.resize(size_t(levels_) * kParentClasses * kContextsPerLevel);
-    static_assert(size_t(kNeighbourhoodClasses) * kSmallNodes == kFamilySize[int(ModelFamily::CellCounts)]);
+    static_assert(size_t(kNeighbourhoodClasses) * kNeighbourhoodNodes == kFamilySize[int(ModelFamily::CellCounts)]);
     if (neighbourhoods) {
       neighbourhoodModels_.resize(kFamilySize[int(ModelFamily::CellCounts)]);
       primeModels(ModelFamily::CellCounts, neighbourhoodModels_.data());
@@ -79,8 +81,9 @@ class CountCoder {
     // With a neighbourhood class, each decision mixes the class's model with
     // the level's.
     BitModel* byNeighbourhood =
-        neighbourhoodClass > 0 && population <= kExactPopulations
-            ? &neighbourhoodModels_[size_t(neighbourhoodClass) * kSmallNodes + populationOffset(population)]
+        neighbourhoodClass > 0
+            ? &neighbourhoodModels_[size_t(neighbourhoodClass) * kNeighbourhoodNodes +
+                                    (population <= kExactPopulations ? populationOffset(population) : kSmallNodes)]
             : nullptr;
     uint32_t low = 0, candidates = population + 1, node = 1;
     while (candidates > 1) {
@@ -110,6 +113,7 @@ class CountCoder {
   // bit width 5..32, use the full tree.
   static constexpr uint32_t kSmallNodes = 2 + 4 * 2 + 8 * 4 + 16 * 8;
   static constexpr uint32_t kContextsPerLevel = kSmallNodes + 28 * kTreeNodes;
+  static constexpr uint32_t kNeighbourhoodNodes = kSmallNodes + kTreeNodes;
 
   static uint32_t populationOffset(uint32_t p) {
     if (p <= kExactPopulations) {
