@@ -28,7 +28,7 @@ enum class ModelFamily {
   TriangleCodes,
 };
 constexpr int kModelFamilies = 7;
-constexpr std::array<size_t, kModelFamilies> kFamilySize = {9000, 6000, 3042, 300, 250, 150, 864};
+constexpr std::array<size_t, kModelFamilies> kFamilySize = {9000, 11760, 3042, 300, 250, 294, 864};
 
 // As many observations as a prior is worth: the slow estimator then starts
 // at a moderate rate and still follows the model at hand.

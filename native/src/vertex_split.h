@@ -149,7 +149,7 @@ class VertexSplitter {
   SimplexStore& store_;
   const PositionPredictor& geometry_;
   std::vector<Entry> star_;
-  std::vector<double> cosines_;
+  std::vector<double> cosines_, lengths_;  // per edge of the star
   std::vector<uint32_t> codingOrder_;  // star_ indices in the order codes are taken
   // When some edge of the star has more than two fan neighbours (its links
   // hold two), the fan neighbours of every edge (star_ indices): those of
@@ -170,7 +170,7 @@ class VertexSplitter {
   // separates a tetrahedral mesh's star in two).
   static constexpr int kTriangleClasses = 18;
   BitModel triangleModels_[3][kTriangleClasses][16][3];
-  static constexpr int kEdgeClasses = 25;
+  static constexpr int kEdgeClasses = 49;
   // Edges: [cut state][fan codes][class][all four codes possible] (an
   // edge's only face is the vertex, coded 3 or 4, so it has two sets). The
   // cut state is the count of edges coded 4 so far (0..2) or, at geometric
