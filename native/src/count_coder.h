@@ -30,8 +30,12 @@ namespace kdmesh {
 // nothing), and whether the prediction favours the first half, in which case
 // the count of the second half is coded instead (mirroring).
 struct CountContext {
+  static constexpr int kElongationGroups = 3;
   int neighbourhoodClass = 0;
   bool mirrored = false;
+  // How the neighbours spread along the split axis (0..2), which picks the
+  // mixer weights of a class.
+  int elongation = 0;
 };
 
 class CountCoder {
@@ -41,7 +45,7 @@ class CountCoder {
   // `neighbourhoods`: code() may be given neighbourhood classes (streams
   // with connectivity).
   CountCoder(int levels, bool neighbourhoods)
-      : levels_(levels < 1 ? 1 : levels), mixer_(kNeighbourhoodClasses, {45875, 19661}) {
+      : levels_(levels < 1 ? 1 : levels), mixer_(CountContext::kElongationGroups * kNeighbourhoodClasses, {45875, 19661}) {
     models_.resize(size_t(levels_) * kParentClasses * kContextsPerLevel);
     static_assert(size_t(kNeighbourhoodClasses) * kNeighbourhoodNodes == kFamilySize[int(ModelFamily::CellCounts)]);
     if (neighbourhoods) {
@@ -68,14 +72,14 @@ class CountCoder {
                 uint32_t firstHalf, const CountContext& context = {}) {
     const uint32_t coded = codeOrdered(coder, population, level, parentOneSided,
                                        context.mirrored ? population - firstHalf : firstHalf,
-                                       context.neighbourhoodClass);
+                                       context.neighbourhoodClass, context.elongation);
     return context.mirrored ? population - coded : coded;
   }
 
  private:
   template <class Coder>
   uint32_t codeOrdered(Coder& coder, uint32_t population, int level, bool parentOneSided,
-                       uint32_t firstHalf, int neighbourhoodClass) {
+                       uint32_t firstHalf, int neighbourhoodClass, int elongation) {
     BitModel* models = &models_[(size_t(level) * kParentClasses + parentOneSided) * kContextsPerLevel +
                                 populationOffset(population)];
     // With a neighbourhood class, each decision mixes the class's model with
@@ -92,7 +96,8 @@ class CountCoder {
       const uint32_t lowerHalf = candidates >> 1;
       bool upper = firstHalf - low >= lowerHalf;
       if (byNeighbourhood)
-        upper = mixer_.code(coder, neighbourhoodClass, {&byNeighbourhood[node], &models[node]}, upper);
+        upper = mixer_.code(coder, elongation * kNeighbourhoodClasses + neighbourhoodClass,
+                            {&byNeighbourhood[node], &models[node]}, upper);
       else
         upper = coder.bit(models[node], upper);
       if (upper) {

@@ -14,6 +14,7 @@ constexpr int kValenceClasses = 5;       // the last: no triangle
 constexpr int kJointValenceClasses = 3;
 constexpr int kPlaneBuckets = 6;
 constexpr int kCentroidBuckets = 10;
+constexpr int kElongationGroups = CountContext::kElongationGroups;
 
 // The root mean square neighbour distance in half widths of the cell, from
 // its square.
@@ -38,6 +39,17 @@ int tiltClass(double tilt) {
   return countAtMost(tilt, kBounds);
 }
 
+// How the neighbours spread along the split axis against their spread in
+// all three: 3 · (squared offsets along the axis) / (squared offsets), < 0.5,
+// < 1.6 or more. Neighbours strung out along the axis leave a vertex's
+// position along it (or a cell's split) less certain than the other
+// features say: the mixers weigh their models by it (bunny −0.07 bits per
+// vertex, fandisk −0.09, dragon −0.05).
+int elongationGroup(double squared, double along) {
+  static constexpr double kBounds[kElongationGroups - 1] = {0.5, 1.6};
+  return squared > 0 ? countAtMost(3 * along / squared, kBounds) : 1;
+}
+
 // Offsets from the split plane in half widths; the plane's is >= 0 after
 // mirroring, the centroid's may have either sign.
 int planeBucket(double t) {
@@ -60,7 +72,7 @@ PositionPredictor::PositionPredictor(const SplitSchedule& schedule, const Simple
       planeModels_(size_t(kOutsideClasses) * kScaleClasses * kTiltClasses * kPlaneBuckets),
       centroidModels_(size_t(kValenceClasses) * kScaleClasses * kCentroidBuckets),
       // The joint model is the sharpest; the others help while it learns.
-      mixer_(kScaleClasses, {39322, 19661, 19661}) {
+      mixer_(kElongationGroups * kScaleClasses, {39322, 19661, 19661}) {
   static_assert(size_t(kJointValenceClasses) * kOutsideClasses * kScaleClasses * kTiltClasses * kPlaneBuckets *
                     kCentroidBuckets ==
                 kFamilySize[int(ModelFamily::OneVertexSplits)]);
@@ -89,6 +101,7 @@ PositionPredictor::Features PositionPredictor::features(const Neighbourhood& aro
   double centroid[3];  // relative to the cell centre
   for (int a = 0; a < 3; ++a) centroid[a] = around.sum[a] * inverse;
   f.meanSquaredDistance = around.squaredDistance * inverse * (inverseHalfWidth * inverseHalfWidth);
+  f.elongation = elongationGroup(around.squaredDistance, around.squaredAlong);
   f.centroidOffset = centroid[axis] * inverseHalfWidth;
   const double* normal = around.normal;
   const double along = std::fabs(normal[axis]) * halfWidth[axis];
@@ -116,13 +129,13 @@ PositionPredictor::Features PositionPredictor::features(const Neighbourhood& aro
 // The incidence lists are walked where they are. A snapshot of them in
 // contiguous rows, rebuilt twice per level, took more instructions (bunny
 // decode 1.156 G against 1.135 G) and 24 bytes per triangle more memory.
-bool PositionPredictor::gather(uint32_t vertex, Neighbourhood& around) const {
+bool PositionPredictor::gather(uint32_t vertex, int axis, Neighbourhood& around) const {
   if (vertex >= store_.vertexCapacity() || vertex >= places_.size()) return false;
   // Scalars rather than arrays: these loops, the decoder's hottest, stalled
   // on store-to-load forwarding with array temporaries.
   const double* at = places_[vertex].centre;
-  const double atX = at[0], atY = at[1], atZ = at[2];
-  double sumX = 0, sumY = 0, sumZ = 0, normalX = 0, normalY = 0, normalZ = 0, squared = 0;
+  const double atX = at[0], atY = at[1], atZ = at[2], atAxis = at[axis];
+  double sumX = 0, sumY = 0, sumZ = 0, normalX = 0, normalY = 0, normalZ = 0, squared = 0, along = 0;
   uint32_t count = 0;
   // Each triangle adds the vertex that follows this one in its winding
   // (around a closed, consistently wound fan, every neighbour once) and the
@@ -143,13 +156,14 @@ bool PositionPredictor::gather(uint32_t vertex, Neighbourhood& around) const {
     sumY += ay;
     sumZ += az;
     squared += ax * ax + ay * ay + az * az;
+    along += (a[axis] - atAxis) * (a[axis] - atAxis);
     normalX += ay * bz - az * by;
     normalY += az * bx - ax * bz;
     normalZ += ax * by - ay * bx;
     ++count;
   });
   if (count > 0) {
-    around = {{sumX, sumY, sumZ}, {normalX, normalY, normalZ}, squared, count, true};
+    around = {{sumX, sumY, sumZ}, {normalX, normalY, normalZ}, squared, along, count, true};
     return true;
   }
   // No triangle: the other ends of the edges.
@@ -163,6 +177,7 @@ bool PositionPredictor::gather(uint32_t vertex, Neighbourhood& around) const {
     squared += x * x;
     squared += y * y;
     squared += z * z;
+    along += (centre[axis] - atAxis) * (centre[axis] - atAxis);
     const double crossX = previousY * z - previousZ * y;
     const double crossY = previousZ * x - previousX * z;
     const double crossZ = previousX * y - previousY * x;
@@ -177,13 +192,13 @@ bool PositionPredictor::gather(uint32_t vertex, Neighbourhood& around) const {
     ++count;
   });
   if (count == 0) return false;
-  around = {{sumX, sumY, sumZ}, {normalX, normalY, normalZ}, squared, count, false};
+  around = {{sumX, sumY, sumZ}, {normalX, normalY, normalZ}, squared, along, count, false};
   return true;
 }
 
 bool PositionPredictor::contextsOf(uint32_t vertex, int level, SingleContexts& c) {
   Neighbourhood around;
-  if (!gather(vertex, around)) return false;
+  if (!gather(vertex, axis_[size_t(level)], around)) return false;
   ++positionPredictions_;
   const Features f = features(around, level);
   c.mirrored = f.mirrored;
@@ -196,32 +211,33 @@ bool PositionPredictor::contextsOf(uint32_t vertex, int level, SingleContexts& c
                 kCentroidBuckets +
             centroid;
   c.centroid = (valence * kScaleClasses + scale) * kCentroidBuckets + centroid;
-  c.mixerSet = scale;
+  c.mixerSet = f.elongation * kScaleClasses + scale;
   return true;
 }
 
 CountContext PositionPredictor::countContext(uint32_t vertex, int level) {
   Neighbourhood around;
-  if (!gather(vertex, around)) return {};
+  if (!gather(vertex, axis_[size_t(level)], around)) return {};
   ++countPredictions_;
   const Features f = features(around, level);
   if (!f.hasPlane) {
     const double c = f.centroidOffset;
-    return {c < 0.5 ? 10 : c < 1.5 ? 11 : 12, f.mirrored};
+    return {c < 0.5 ? 10 : c < 1.5 ? 11 : 12, f.mirrored, f.elongation};
   }
   // The plane meets the cell's column along the split axis between
   // planeOffset - tilt and planeOffset + tilt (in half widths).
   const double low = f.planeOffset - f.tilt, high = f.planeOffset + f.tilt;
   if (low > 0) {
     // It stays in the upper half: how close it comes to the split plane.
-    return {low < 0.5 ? 6 : low < 1 ? 7 : low < 2 ? 8 : 9, f.mirrored};
+    return {low < 0.5 ? 6 : low < 1 ? 7 : low < 2 ? 8 : 9, f.mirrored, f.elongation};
   }
   // It crosses the split plane: which share of its span inside the cell
   // lies in the lower half (at most about a half, since mirrored).
   const double inside = std::min(high, 1.0) - std::max(low, -1.0);
   const double below = std::min(high, 0.0) - std::max(low, -1.0);
   static constexpr double kShareBounds[4] = {0.08, 0.2, 0.32, 0.44};
-  return {1 + countAtMost(inside > 0 && below > 0 ? below / inside : 0.0, kShareBounds), f.mirrored};
+  return {1 + countAtMost(inside > 0 && below > 0 ? below / inside : 0.0, kShareBounds), f.mirrored,
+          f.elongation};
 }
 
 }  // namespace kdmesh

@@ -145,6 +145,7 @@ class PositionPredictor {
   struct Neighbourhood {
     double sum[3], normal[3];
     double squaredDistance;
+    double squaredAlong;  // of the offsets along the split axis
     uint32_t count;
     bool oriented;
   };
@@ -156,15 +157,17 @@ class PositionPredictor {
     double tilt = 0;                 // the plane's rise across the cell
     double centroidOffset = 0;
     double meanSquaredDistance = 0;  // of the neighbours, in squared half widths
+    int elongation = 1;              // elongationGroup() (position_predictor.cpp)
     bool hasPlane = false, mirrored = false;
     bool outsideUp = false;  // an oriented normal points to the upper half
   };
   Features features(const Neighbourhood& around, int level) const;
-  // Sums the neighbours of `vertex`; false without any.
-  bool gather(uint32_t vertex, Neighbourhood& around) const;
+  // Sums the neighbours of `vertex` (squaredAlong along `axis`); false
+  // without any.
+  bool gather(uint32_t vertex, int axis, Neighbourhood& around) const;
   // The models of a one-vertex split: one for the joint class of all
   // features, one for the plane's alone, one for the centroid's alone,
-  // mixed with weights chosen by the neighbours' distance.
+  // mixed with weights chosen by the neighbours' distance and elongation.
   struct SingleContexts {
     int joint, plane, centroid, mixerSet;
     bool mirrored;
