@@ -6,28 +6,60 @@ namespace {
 // kOneVertexSplitPriors, kEdgeCodePriors, kCellCountPriors,
 // kOneVertexByPlanePriors, kOneVertexByCentroidPriors,
 // kEdgeCodeByDirectionPriors, kTriangleCodePriors: P(bit == 0) in units of
-// 2^-15, one per model.
+// 2^-15, one per model, run-length coded (model_priors.h).
 #include "model_priors.inc"
 
-static_assert(sizeof(kOneVertexSplitPriors) / sizeof(uint16_t) == kFamilySize[0]);
-static_assert(sizeof(kEdgeCodePriors) / sizeof(uint16_t) == kFamilySize[1]);
-static_assert(sizeof(kCellCountPriors) / sizeof(uint16_t) == kFamilySize[2]);
-static_assert(sizeof(kOneVertexByPlanePriors) / sizeof(uint16_t) == kFamilySize[3]);
-static_assert(sizeof(kOneVertexByCentroidPriors) / sizeof(uint16_t) == kFamilySize[4]);
-static_assert(sizeof(kEdgeCodeByDirectionPriors) / sizeof(uint16_t) == kFamilySize[5]);
-static_assert(sizeof(kTriangleCodePriors) / sizeof(uint16_t) == kFamilySize[6]);
+// How many models a run-length coded family primes.
+template <size_t kCoded>
+constexpr size_t expandedSize(const uint16_t (&coded)[kCoded]) {
+  size_t models = 0;
+  for (size_t i = 0; i < kCoded; ++i) {
+    if (coded[i] == kPriorRunMarker) {
+      models += coded[++i];
+    } else {
+      ++models;
+    }
+  }
+  return models;
+}
+
+static_assert(expandedSize(kOneVertexSplitPriors) == kFamilySize[0]);
+static_assert(expandedSize(kEdgeCodePriors) == kFamilySize[1]);
+static_assert(expandedSize(kCellCountPriors) == kFamilySize[2]);
+static_assert(expandedSize(kOneVertexByPlanePriors) == kFamilySize[3]);
+static_assert(expandedSize(kOneVertexByCentroidPriors) == kFamilySize[4]);
+static_assert(expandedSize(kEdgeCodeByDirectionPriors) == kFamilySize[5]);
+static_assert(expandedSize(kTriangleCodePriors) == kFamilySize[6]);
+
+struct CodedFamily {
+  const uint16_t* values;
+  size_t size;
+};
+template <size_t kCoded>
+constexpr CodedFamily family(const uint16_t (&coded)[kCoded]) {
+  return {coded, kCoded};
+}
 
 }  // namespace
 
 void primeModels(ModelFamily family, BitModel* models) {
-  static const uint16_t* const kPriors[kModelFamilies] = {kOneVertexSplitPriors, kEdgeCodePriors,
-                                                          kCellCountPriors, kOneVertexByPlanePriors,
-                                                          kOneVertexByCentroidPriors, kEdgeCodeByDirectionPriors,
-                                                          kTriangleCodePriors};
-  const uint16_t* priors = kPriors[int(family)];
-  for (size_t i = 0; i < kFamilySize[size_t(family)]; ++i) {
-    models[i].fast = models[i].slow = priors[i];
-    models[i].seen = kPriorObservations;
+  static constexpr CodedFamily kPriors[kModelFamilies] = {
+      kdmesh::family(kOneVertexSplitPriors),      kdmesh::family(kEdgeCodePriors),
+      kdmesh::family(kCellCountPriors),           kdmesh::family(kOneVertexByPlanePriors),
+      kdmesh::family(kOneVertexByCentroidPriors), kdmesh::family(kEdgeCodeByDirectionPriors),
+      kdmesh::family(kTriangleCodePriors)};
+  const CodedFamily& coded = kPriors[int(family)];
+  auto prime = [&models](uint16_t prior) {
+    models->fast = models->slow = prior;
+    models->seen = kPriorObservations;
+    ++models;
+  };
+  for (size_t i = 0; i < coded.size; ++i) {
+    if (coded.values[i] == kPriorRunMarker) {
+      for (uint16_t run = coded.values[++i]; run > 0; --run) prime(uint16_t(kProbabilityOne / 2));
+    } else {
+      prime(coded.values[i]);
+    }
   }
 }
 

@@ -30,6 +30,12 @@ enum class ModelFamily {
 constexpr int kModelFamilies = 7;
 constexpr std::array<size_t, kModelFamilies> kFamilySize = {9000, 11760, 3042, 300, 250, 294, 864};
 
+// model_priors.inc holds each family run-length coded: half the models of
+// the large families were never used in training and start at 1/2; a run of
+// them is the pair (kPriorRunMarker, run length). Priors are clamped to
+// [31, 2^15 - 31], so the marker is no prior.
+constexpr uint16_t kPriorRunMarker = 0;
+
 // As many observations as a prior is worth: the slow estimator then starts
 // at a moderate rate and still follows the model at hand.
 constexpr uint16_t kPriorObservations = 24;

@@ -87,15 +87,28 @@ int main(int argc, char** argv) {
   for (int f = 0; f < kdmesh::kModelFamilies; ++f) {
     std::vector<kdmesh::BitModel> compiled(kdmesh::kFamilySize[size_t(f)]);
     kdmesh::primeModels(kdmesh::ModelFamily(f), compiled.data());
-    std::fprintf(out, "const uint16_t %s[%zu] = {", kNames[f], kdmesh::kFamilySize[size_t(f)]);
+    // Run-length form (model_priors.h): a run of models at 1/2 becomes the
+    // pair (kPriorRunMarker, length).
+    std::vector<int> coded;
     for (size_t m = 0; m < kdmesh::kFamilySize[size_t(f)]; ++m) {
       const double w = weight[size_t(f)][m];
-      const int prior = !retrain[size_t(f)] ? int(compiled[m].slow)
-                        : w > 0         ? int(sum[size_t(f)][m] / w + 0.5)
-                                        : int(kdmesh::kProbabilityOne / 2);
-      std::fprintf(out, "%s%s%d", m ? "," : "", m % 16 == 0 ? "\n    " : " ",
-                   std::clamp(prior, 31, int(kdmesh::kProbabilityOne) - 31));
+      const int prior = std::clamp(!retrain[size_t(f)] ? int(compiled[m].slow)
+                                   : w > 0         ? int(sum[size_t(f)][m] / w + 0.5)
+                                                   : int(kdmesh::kProbabilityOne / 2),
+                                   31, int(kdmesh::kProbabilityOne) - 31);
+      const bool half = prior == int(kdmesh::kProbabilityOne / 2);
+      if (half && coded.size() >= 2 && coded[coded.size() - 2] == kdmesh::kPriorRunMarker &&
+          coded.back() < 0xffff) {
+        ++coded.back();
+      } else if (half) {
+        coded.insert(coded.end(), {kdmesh::kPriorRunMarker, 1});
+      } else {
+        coded.push_back(prior);
+      }
     }
+    std::fprintf(out, "constexpr uint16_t %s[%zu] = {", kNames[f], coded.size());
+    for (size_t i = 0; i < coded.size(); ++i)
+      std::fprintf(out, "%s%s%d", i ? "," : "", i % 16 == 0 ? "\n    " : " ", coded[i]);
     std::fprintf(out, "};\n");
   }
   return std::fclose(out) == 0 ? 0 : 1;
