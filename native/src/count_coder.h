@@ -10,8 +10,8 @@
 //   - and, in a complex, a class of the cell's neighbourhood
 //     (PositionPredictor::countContext), whose model is mixed with the one
 //     above. Populations above 15 share one model per class and tree node:
-//     few cells are that large, and each population's own models learned
-//     too slowly to pay (bunny −0.05 bits per vertex with them shared).
+//     few cells are that large (bunny −0.06 bits per vertex; −0.05 with a
+//     row per bit width of the population, which learns more slowly).
 // After six decisions the few remaining candidates of a large cell are nearly
 // equiprobable and are coded uniformly.
 #pragma once

@@ -36,7 +36,7 @@ struct CodedFamily {
   size_t size;
 };
 template <size_t kCoded>
-constexpr CodedFamily family(const uint16_t (&coded)[kCoded]) {
+constexpr CodedFamily codedFamily(const uint16_t (&coded)[kCoded]) {
   return {coded, kCoded};
 }
 
@@ -44,10 +44,10 @@ constexpr CodedFamily family(const uint16_t (&coded)[kCoded]) {
 
 void primeModels(ModelFamily family, BitModel* models) {
   static constexpr CodedFamily kPriors[kModelFamilies] = {
-      kdmesh::family(kOneVertexSplitPriors),      kdmesh::family(kEdgeCodePriors),
-      kdmesh::family(kCellCountPriors),           kdmesh::family(kOneVertexByPlanePriors),
-      kdmesh::family(kOneVertexByCentroidPriors), kdmesh::family(kEdgeCodeByDirectionPriors),
-      kdmesh::family(kTriangleCodePriors)};
+      codedFamily(kOneVertexSplitPriors),      codedFamily(kEdgeCodePriors),
+      codedFamily(kCellCountPriors),           codedFamily(kOneVertexByPlanePriors),
+      codedFamily(kOneVertexByCentroidPriors), codedFamily(kEdgeCodeByDirectionPriors),
+      codedFamily(kTriangleCodePriors)};
   const CodedFamily& coded = kPriors[int(family)];
   auto prime = [&models](uint16_t prior) {
     models->fast = models->slow = prior;

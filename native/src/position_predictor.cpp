@@ -43,8 +43,8 @@ int tiltClass(double tilt) {
 // all three: 3 · (squared offsets along the axis) / (squared offsets), < 0.5,
 // < 1.6 or more. Neighbours strung out along the axis leave a vertex's
 // position along it (or a cell's split) less certain than the other
-// features say: the mixers weigh their models by it (bunny −0.07 bits per
-// vertex, fandisk −0.09, dragon −0.05).
+// features say: the mixers weigh their models by it (bunny −0.08 bits per
+// vertex, fandisk −0.09, dragon −0.04).
 int elongationGroup(double squared, double along) {
   static constexpr double kBounds[kElongationGroups - 1] = {0.5, 1.6};
   return squared > 0 ? countAtMost(3 * along / squared, kBounds) : 1;

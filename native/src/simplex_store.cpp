@@ -106,12 +106,11 @@ uint32_t SimplexStore::add(int dimension, const uint32_t* vertices, uint8_t flag
     if (size_t(live_[dimension]) * 2 > pool.table.size()) grow(dimension);
     insertIndex(dimension, simplex);
   }
-  // Linked as link() does, each slot's successor pushed rather than set
-  // after a resize (the decoder's third most frequent call).
-  std::vector<uint32_t>& heads = heads_[dimension];
+  // Slots pushed one by one: resize() was an out-of-line call in the
+  // decoder's third most frequent function.
   for (uint32_t i = 0; i < arity; ++i) {
-    pool.next.push_back(heads[vertices[i]]);
-    heads[vertices[i]] = simplex * uint32_t(arity) + i;
+    pool.next.push_back(kNoSimplex);
+    link(dimension, simplex, i);
   }
   return simplex;
 }

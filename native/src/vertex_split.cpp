@@ -166,6 +166,7 @@ void VertexSplitter::classifyEdges(uint32_t v, int level) {
   // plane's patch between v and v2 (tetrahedral ball: −0.7 bits per vertex
   // against the crossing class).
   const bool volume = begin_[4] > begin_[3];
+  double meanLength = 0;
   for (size_t i = first; i < last; ++i) {
     double to[3], squared = 0;
     geometry_.centreOf(star_[i].others[0], to);
@@ -175,6 +176,7 @@ void VertexSplitter::classifyEdges(uint32_t v, int level) {
     }
     const double length = std::sqrt(squared);
     lengths_[i - first] = length;
+    meanLength += length;
     cosines_[i - first] = squared > 0 ? to[axis] / length : 0;
     if (volume) {
       // Length in half widths of the cell along the split axis.
@@ -184,8 +186,6 @@ void VertexSplitter::classifyEdges(uint32_t v, int level) {
     }
   }
   if (volume) return;
-  double meanLength = 0;
-  for (size_t i = first; i < last; ++i) meanLength += lengths_[i - first];
   meanLength /= double(last - first);
   for (size_t i = first; i < last; ++i) {
     const double cosine = cosines_[i - first], magnitude = std::fabs(cosine);
