@@ -251,9 +251,10 @@ int runInfo(const std::string& input, bool json) {
     std::printf("], \"orientationBits\": %" PRIu64 ", \"orientationMispredicted\": %" PRIu64 "},\n",
                 stats.orientationBits, stats.orientationMispredicted);
     std::printf("  \"predictions\": {\"edgeCodesByDirection\": %" PRIu64 ", \"countPredictions\": %" PRIu64
-                ", \"positionPredictions\": %" PRIu64 ", \"pairedTriangles\": %" PRIu64 "},\n",
+                ", \"positionPredictions\": %" PRIu64 ", \"parallelogramPredictions\": %" PRIu64
+                ", \"pairedTriangles\": %" PRIu64 "},\n",
                 stats.edgeCodesByDirection, stats.countPredictions, stats.positionPredictions,
-                stats.pairedTriangles);
+                stats.parallelogramPredictions, stats.pairedTriangles);
     std::printf("  \"chunks\": [");
     const auto& chunks = decoder.chunks();
     for (size_t i = 0; i < chunks.size(); ++i)
@@ -295,10 +296,10 @@ int runInfo(const std::string& input, bool json) {
     std::printf("  orientation   %" PRIu64 " decisions, %" PRIu64 " mispredicted\n", stats.orientationBits,
                 stats.orientationMispredicted);
     std::printf("predictions     %" PRIu64 " edge codes by split direction, %" PRIu64
-                " cell counts and %" PRIu64 " one-vertex splits from the neighbourhood, %" PRIu64
-                " triangles by pairing\n",
+                " cell counts and %" PRIu64 " one-vertex splits from the neighbourhood (%" PRIu64
+                " of them with parallelograms), %" PRIu64 " triangles by pairing\n",
                 stats.edgeCodesByDirection, stats.countPredictions, stats.positionPredictions,
-                stats.pairedTriangles);
+                stats.parallelogramPredictions, stats.pairedTriangles);
   }
   std::printf("chunks          %zu\n", decoder.chunks().size());
   std::printf("  %5s %10s %8s %10s\n", "chunk", "offset", "payload", "splits");

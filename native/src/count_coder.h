@@ -8,14 +8,17 @@
 //   - whether the parent split sent all its vertices to one side, and
 //   - the node of the bisection tree (the decisions taken so far),
 //   - and, in a complex, a class of the cell's neighbourhood
-//     (PositionPredictor::countContext), whose model is mixed with the one
-//     above. Populations above 15 share one model per class and tree node:
+//     (PositionPredictor::countContext) and where the neighbours'
+//     parallelogram predictions put the cell's vertex, whose models are
+//     mixed with the one above (the latter: bunny −0.02 bits per vertex,
+//     triceratops −0.07). Populations above 15 share one model per class and tree node:
 //     few cells are that large (bunny −0.06 bits per vertex; −0.05 with a
 //     row per bit width of the population, which learns more slowly).
 // After six decisions the few remaining candidates of a large cell are nearly
 // equiprobable and are coded uniformly.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
 #include <vector>
 
@@ -36,6 +39,10 @@ struct CountContext {
   // How the neighbours spread along the split axis (0..2), which picks the
   // mixer weights of a class.
   int elongation = 0;
+  // Where the neighbours' parallelogram predictions put the cell's vertex
+  // (PositionPredictor), kParallelogramBuckets - 1 for nowhere.
+  static constexpr int kParallelogramBuckets = 12;
+  int parallelogram = kParallelogramBuckets - 1;
 };
 
 class CountCoder {
@@ -45,16 +52,21 @@ class CountCoder {
   // `neighbourhoods`: code() may be given neighbourhood classes (streams
   // with connectivity).
   CountCoder(int levels, bool neighbourhoods)
-      : levels_(levels < 1 ? 1 : levels), mixer_(CountContext::kElongationGroups * kNeighbourhoodClasses, {45875, 19661}) {
+      : levels_(levels < 1 ? 1 : levels), mixer_(CountContext::kElongationGroups * kNeighbourhoodClasses, {45875, 19661, 19661}) {
     models_.resize(size_t(levels_) * kParentClasses * kContextsPerLevel);
     static_assert(size_t(kNeighbourhoodClasses) * kNeighbourhoodNodes == kFamilySize[int(ModelFamily::CellCounts)]);
     if (neighbourhoods) {
       neighbourhoodModels_.resize(kFamilySize[int(ModelFamily::CellCounts)]);
       primeModels(ModelFamily::CellCounts, neighbourhoodModels_.data());
+      static_assert(size_t(kPopulationGroups) * CountContext::kParallelogramBuckets * kParallelogramNodes ==
+                    kFamilySize[int(ModelFamily::CellCountsByParallelogram)]);
+      parallelogramModels_.resize(kFamilySize[int(ModelFamily::CellCountsByParallelogram)]);
+      primeModels(ModelFamily::CellCountsByParallelogram, parallelogramModels_.data());
     }
   }
 
   const std::vector<BitModel>& neighbourhoodModels() const { return neighbourhoodModels_; }
+  const std::vector<BitModel>& parallelogramModels() const { return parallelogramModels_; }
 
   // The count of a one-vertex cell, 1 when the vertex is in the first half;
   // the same model as code() with population 1, in a loop-free form.
@@ -72,14 +84,14 @@ class CountCoder {
                 uint32_t firstHalf, const CountContext& context = {}) {
     const uint32_t coded = codeOrdered(coder, population, level, parentOneSided,
                                        context.mirrored ? population - firstHalf : firstHalf,
-                                       context.neighbourhoodClass, context.elongation);
+                                       context.neighbourhoodClass, context.elongation, context.parallelogram);
     return context.mirrored ? population - coded : coded;
   }
 
  private:
   template <class Coder>
   uint32_t codeOrdered(Coder& coder, uint32_t population, int level, bool parentOneSided,
-                       uint32_t firstHalf, int neighbourhoodClass, int elongation) {
+                       uint32_t firstHalf, int neighbourhoodClass, int elongation, int parallelogram) {
     BitModel* models = &models_[(size_t(level) * kParentClasses + parentOneSided) * kContextsPerLevel +
                                 populationOffset(population)];
     // With a neighbourhood class, each decision mixes the class's model with
@@ -89,6 +101,15 @@ class CountCoder {
             ? &neighbourhoodModels_[size_t(neighbourhoodClass) * kNeighbourhoodNodes +
                                     (population <= kExactPopulations ? populationOffset(population) : kSmallNodes)]
             : nullptr;
+    // And with the model of where the parallelogram predictions put the
+    // cell's vertex, by population group (2, 3, 4-7, more); the nodes of
+    // trees deeper than a population of 15 needs share the last.
+    const int populationGroup = population <= 2 ? 0 : population == 3 ? 1 : population <= 7 ? 2 : 3;
+    BitModel* byParallelogram =
+        neighbourhoodClass > 0
+            ? &parallelogramModels_[size_t(populationGroup * CountContext::kParallelogramBuckets + parallelogram) *
+                                    kParallelogramNodes]
+            : nullptr;
     uint32_t low = 0, candidates = population + 1, node = 1;
     while (candidates > 1) {
       if (node >= kTreeNodes)
@@ -97,7 +118,9 @@ class CountCoder {
       bool upper = firstHalf - low >= lowerHalf;
       if (byNeighbourhood)
         upper = mixer_.code(coder, elongation * kNeighbourhoodClasses + neighbourhoodClass,
-                            {&byNeighbourhood[node], &models[node]}, upper);
+                            {&byNeighbourhood[node], &models[node],
+                             &byParallelogram[std::min(node, kParallelogramNodes - 1)]},
+                            upper);
       else
         upper = coder.bit(models[node], upper);
       if (upper) {
@@ -119,6 +142,8 @@ class CountCoder {
   static constexpr uint32_t kSmallNodes = 2 + 4 * 2 + 8 * 4 + 16 * 8;
   static constexpr uint32_t kContextsPerLevel = kSmallNodes + 28 * kTreeNodes;
   static constexpr uint32_t kNeighbourhoodNodes = kSmallNodes + kTreeNodes;
+  static constexpr int kPopulationGroups = 4;
+  static constexpr uint32_t kParallelogramNodes = 16;
 
   static uint32_t populationOffset(uint32_t p) {
     if (p <= kExactPopulations) {
@@ -134,8 +159,8 @@ class CountCoder {
   }
 
   int levels_;
-  std::vector<BitModel> models_, neighbourhoodModels_;
-  Mixer<2> mixer_;
+  std::vector<BitModel> models_, neighbourhoodModels_, parallelogramModels_;
+  Mixer<3> mixer_;
 };
 
 }  // namespace kdmesh

@@ -322,7 +322,9 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
     keep(ModelFamily::OneVertexSplits, predictor.models().data());
     keep(ModelFamily::OneVertexByPlane, predictor.planeModels().data());
     keep(ModelFamily::OneVertexByCentroid, predictor.centroidModels().data());
+    keep(ModelFamily::OneVertexByParallelogram, predictor.parallelogramModels().data());
     keep(ModelFamily::CellCounts, counts.neighbourhoodModels().data());
+    keep(ModelFamily::CellCountsByParallelogram, counts.parallelogramModels().data());
     keep(ModelFamily::EdgeCodes, splitter.edgeModels());
     keep(ModelFamily::EdgeCodesByDirection, splitter.edgeDirectionModels());
     keep(ModelFamily::TriangleCodes, splitter.triangleModels());

@@ -5,7 +5,8 @@ namespace {
 
 // kOneVertexSplitPriors, kEdgeCodePriors, kCellCountPriors,
 // kOneVertexByPlanePriors, kOneVertexByCentroidPriors,
-// kEdgeCodeByDirectionPriors, kTriangleCodePriors: P(bit == 0) in units of
+// kEdgeCodeByDirectionPriors, kTriangleCodePriors,
+// kOneVertexByParallelogramPriors, kCellCountByParallelogramPriors: P(bit == 0) in units of
 // 2^-15, one per model, run-length coded (model_priors.h).
 #include "model_priors.inc"
 
@@ -30,6 +31,8 @@ static_assert(expandedSize(kOneVertexByPlanePriors) == kFamilySize[3]);
 static_assert(expandedSize(kOneVertexByCentroidPriors) == kFamilySize[4]);
 static_assert(expandedSize(kEdgeCodeByDirectionPriors) == kFamilySize[5]);
 static_assert(expandedSize(kTriangleCodePriors) == kFamilySize[6]);
+static_assert(expandedSize(kOneVertexByParallelogramPriors) == kFamilySize[7]);
+static_assert(expandedSize(kCellCountByParallelogramPriors) == kFamilySize[8]);
 
 struct CodedFamily {
   const uint16_t* values;
@@ -47,7 +50,8 @@ void primeModels(ModelFamily family, BitModel* models) {
       codedFamily(kOneVertexSplitPriors),      codedFamily(kEdgeCodePriors),
       codedFamily(kCellCountPriors),           codedFamily(kOneVertexByPlanePriors),
       codedFamily(kOneVertexByCentroidPriors), codedFamily(kEdgeCodeByDirectionPriors),
-      codedFamily(kTriangleCodePriors)};
+      codedFamily(kTriangleCodePriors),        codedFamily(kOneVertexByParallelogramPriors),
+      codedFamily(kCellCountByParallelogramPriors)};
   const CodedFamily& coded = kPriors[int(family)];
   auto prime = [&models](uint16_t prior) {
     models->fast = models->slow = prior;

@@ -7,6 +7,12 @@
 namespace kdmesh {
 namespace {
 
+// The positions in a triangle's tuple of the vertices that follow the one
+// at position p in the winding, by p and (+3) for a flipped tuple, which
+// winds the other way; a table, since a branch on the flip would be
+// mispredicted for half the triangles.
+constexpr uint8_t kNext[6] = {1, 2, 0, 2, 0, 1}, kAfterNext[6] = {2, 0, 1, 1, 2, 0};
+
 constexpr int kScaleClasses = 5;
 constexpr int kTiltClasses = 5;  // the last: no plane
 constexpr int kOutsideClasses = 2;
@@ -14,6 +20,9 @@ constexpr int kValenceClasses = 5;       // the last: no triangle
 constexpr int kJointValenceClasses = 3;
 constexpr int kPlaneBuckets = 6;
 constexpr int kCentroidBuckets = 10;
+constexpr int kParallelogramBuckets = CountContext::kParallelogramBuckets;  // the last: none
+constexpr int kSpreadClasses = 9;
+constexpr int kAgreementClasses = 3;
 constexpr int kElongationGroups = CountContext::kElongationGroups;
 
 // The root mean square neighbour distance in half widths of the cell, from
@@ -57,6 +66,20 @@ int planeBucket(double t) {
   return countAtMost(t, kBounds);
 }
 
+// The mean parallelogram prediction's offset from the split plane in half
+// widths, mirrored as the plane's.
+int parallelogramBucket(double t) {
+  static constexpr double kBounds[kParallelogramBuckets - 2] = {-2, -1, -0.5, -0.25, 0, 0.25, 0.5, 1, 2, 4};
+  return countAtMost(t, kBounds);
+}
+
+// The variance of the parallelogram predictions along the split axis, in
+// squared half widths: how far to trust their mean.
+int spreadClass(double variance) {
+  static constexpr double kBounds[kSpreadClasses - 1] = {0.125, 0.25, 0.5, 1, 2, 4, 16, 64};
+  return countAtMost(variance, kBounds);
+}
+
 int centroidBucket(double t) {
   static constexpr double kBounds[kCentroidBuckets - 1] = {-2, -1, -0.5, -0.25, 0, 0.25, 0.5, 1, 2};
   return countAtMost(t, kBounds);
@@ -71,8 +94,9 @@ PositionPredictor::PositionPredictor(const SplitSchedule& schedule, const Simple
               kCentroidBuckets),
       planeModels_(size_t(kOutsideClasses) * kScaleClasses * kTiltClasses * kPlaneBuckets),
       centroidModels_(size_t(kValenceClasses) * kScaleClasses * kCentroidBuckets),
+      parallelogramModels_(size_t(kPlaneBuckets) * kSpreadClasses * kParallelogramBuckets),
       // The joint model is the sharpest; the others help while it learns.
-      mixer_(kElongationGroups * kScaleClasses, {39322, 19661, 19661}) {
+      mixer_(kElongationGroups * kScaleClasses * kAgreementClasses, {39322, 19661, 19661, 19661}) {
   static_assert(size_t(kJointValenceClasses) * kOutsideClasses * kScaleClasses * kTiltClasses * kPlaneBuckets *
                     kCentroidBuckets ==
                 kFamilySize[int(ModelFamily::OneVertexSplits)]);
@@ -80,9 +104,12 @@ PositionPredictor::PositionPredictor(const SplitSchedule& schedule, const Simple
                 kFamilySize[int(ModelFamily::OneVertexByPlane)]);
   static_assert(size_t(kValenceClasses) * kScaleClasses * kCentroidBuckets ==
                 kFamilySize[int(ModelFamily::OneVertexByCentroid)]);
+  static_assert(size_t(kPlaneBuckets) * kSpreadClasses * kParallelogramBuckets ==
+                kFamilySize[int(ModelFamily::OneVertexByParallelogram)]);
   primeModels(ModelFamily::OneVertexSplits, models_.data());
   primeModels(ModelFamily::OneVertexByPlane, planeModels_.data());
   primeModels(ModelFamily::OneVertexByCentroid, centroidModels_.data());
+  primeModels(ModelFamily::OneVertexByParallelogram, parallelogramModels_.data());
   widths_.resize(size_t(schedule.levels) + 1);
   for (size_t level = 0; level < widths_.size(); ++level)
     for (int a = 0; a < 3; ++a)
@@ -117,53 +144,95 @@ PositionPredictor::Features PositionPredictor::features(const Neighbourhood& aro
     f.tilt = across / along;
     f.hasPlane = true;
   }
+  if (around.parallelograms > 0) {
+    const double inverseCount = 1.0 / double(around.parallelograms);
+    const double mean = around.parallelogramAlong * inverseCount;
+    f.parallelogramOffset = mean * inverseHalfWidth;
+    f.parallelogramSpread =
+        (around.parallelogramSquaredAlong * inverseCount - mean * mean) * (inverseHalfWidth * inverseHalfWidth);
+    f.hasParallelogram = true;
+  }
   f.mirrored = (f.hasPlane ? f.planeOffset : f.centroidOffset) < 0;
   f.outsideUp = around.oriented && f.hasPlane && (normal[axis] > 0) != f.mirrored;
   if (f.mirrored) {
     f.planeOffset = -f.planeOffset;
     f.centroidOffset = -f.centroidOffset;
+    f.parallelogramOffset = -f.parallelogramOffset;
   }
   return f;
+}
+
+uint32_t PositionPredictor::across(uint32_t slot, uint32_t a, uint32_t b) {
+  if (slot >= acrossSlots_.size())
+    acrossSlots_.resize(std::max<size_t>(size_t(store_.size(2)) * 3, size_t(slot) + 1), kUnknown);
+  uint32_t found = acrossSlots_[slot];
+  if (found == kUnknown) {
+    // In the triangle b a c, wound that way, c follows a and b follows c.
+    found = kNowhere;
+    store_.forEachIncident(2, a, [&](uint32_t triangle, uint32_t position) {
+      const uint32_t row = position + (store_.flags(2, triangle) & SimplexStore::kFlipped ? 3 : 0);
+      if (store_.vertices(2, triangle)[kAfterNext[row]] != b) return false;
+      found = triangle * 3 + kNext[row];
+      return true;
+    });
+    acrossSlots_[slot] = found;
+  }
+  return found == kNowhere ? kNoSimplex : store_.vertexInSlot(2, found);
+}
+
+void PositionPredictor::forgetAcross(uint32_t triangle, uint32_t position) {
+  const size_t first = size_t(triangle) * 3;
+  if (first >= acrossSlots_.size()) return;
+  for (uint32_t p = 0; p < 3; ++p)
+    if (p != position) acrossSlots_[first + p] = kUnknown;
 }
 
 // The incidence lists are walked where they are. A snapshot of them in
 // contiguous rows, rebuilt twice per level, took more instructions (bunny
 // decode 1.156 G against 1.135 G) and 24 bytes per triangle more memory.
-bool PositionPredictor::gather(uint32_t vertex, int axis, Neighbourhood& around) const {
+bool PositionPredictor::gather(uint32_t vertex, int axis, Neighbourhood& around) {
   if (vertex >= store_.vertexCapacity() || vertex >= places_.size()) return false;
   // Scalars rather than arrays: these loops, the decoder's hottest, stalled
   // on store-to-load forwarding with array temporaries.
   const double* at = places_[vertex].centre;
   const double atX = at[0], atY = at[1], atZ = at[2], atAxis = at[axis];
   double sumX = 0, sumY = 0, sumZ = 0, normalX = 0, normalY = 0, normalZ = 0, squared = 0, along = 0;
-  uint32_t count = 0;
+  double parallelogramAlong = 0, parallelogramSquaredAlong = 0;
+  uint32_t count = 0, parallelograms = 0;
   // Each triangle adds the vertex that follows this one in its winding
   // (around a closed, consistently wound fan, every neighbour once) and the
   // cross product of the offsets of that vertex and the next.
   store_.forEachIncident(2, vertex, [&](uint32_t triangle, uint32_t position) {
-    // The positions in the tuple of the vertices that follow this one in
-    // the winding, by position and (+3) for a flipped tuple, which winds the
-    // other way; a table, since a branch on the flip would be mispredicted
-    // for half the triangles.
-    static constexpr uint8_t kNext[6] = {1, 2, 0, 2, 0, 1}, kAfterNext[6] = {2, 0, 1, 1, 2, 0};
     const uint32_t* tuple = store_.vertices(2, triangle);
     const uint32_t row = position + (store_.flags(2, triangle) & SimplexStore::kFlipped ? 3 : 0);
-    const double* a = places_[tuple[kNext[row]]].centre;
-    const double* b = places_[tuple[kAfterNext[row]]].centre;
+    const uint32_t next = tuple[kNext[row]], afterNext = tuple[kAfterNext[row]];
+    const double* a = places_[next].centre;
+    const double* b = places_[afterNext].centre;
     const double ax = a[0] - atX, ay = a[1] - atY, az = a[2] - atZ;
     const double bx = b[0] - atX, by = b[1] - atY, bz = b[2] - atZ;
+    const double aAlong = a[axis] - atAxis;
     sumX += ax;
     sumY += ay;
     sumZ += az;
     squared += ax * ax + ay * ay + az * az;
-    along += (a[axis] - atAxis) * (a[axis] - atAxis);
+    along += aAlong * aAlong;
     normalX += ay * bz - az * by;
     normalY += az * bx - ax * bz;
     normalZ += ax * by - ay * bx;
     ++count;
+    // The parallelogram rule: on a flat, evenly sampled surface v a c b is
+    // a parallelogram, c being the far vertex of the triangle across a b;
+    // summed only along the split axis, where the features look.
+    if (const uint32_t far = across(triangle * 3 + position, next, afterNext); far != kNoSimplex) {
+      const double predicted = aAlong + (b[axis] - atAxis) - (places_[far].centre[axis] - atAxis);
+      parallelogramAlong += predicted;
+      parallelogramSquaredAlong += predicted * predicted;
+      ++parallelograms;
+    }
   });
   if (count > 0) {
-    around = {{sumX, sumY, sumZ}, {normalX, normalY, normalZ}, squared, along, count, true};
+    around = {{sumX, sumY, sumZ}, {normalX, normalY, normalZ}, squared, along,
+              parallelogramAlong, parallelogramSquaredAlong, count, parallelograms, true};
     return true;
   }
   // No triangle: the other ends of the edges.
@@ -192,7 +261,7 @@ bool PositionPredictor::gather(uint32_t vertex, int axis, Neighbourhood& around)
     ++count;
   });
   if (count == 0) return false;
-  around = {{sumX, sumY, sumZ}, {normalX, normalY, normalZ}, squared, along, count, false};
+  around = {{sumX, sumY, sumZ}, {normalX, normalY, normalZ}, squared, along, 0, 0, count, 0, false};
   return true;
 }
 
@@ -211,7 +280,17 @@ bool PositionPredictor::contextsOf(uint32_t vertex, int level, SingleContexts& c
                 kCentroidBuckets +
             centroid;
   c.centroid = (valence * kScaleClasses + scale) * kCentroidBuckets + centroid;
-  c.mixerSet = f.elongation * kScaleClasses + scale;
+  // Mixer weights also by how far the parallelogram predictions agree:
+  // within about 1.4 half widths, farther, or no prediction.
+  const int agreement = !f.hasParallelogram ? 2 : f.parallelogramSpread < 2 ? 0 : 1;
+  c.mixerSet = (f.elongation * kScaleClasses + scale) * kAgreementClasses + agreement;
+  const int parallelogram =
+      f.hasParallelogram ? parallelogramBucket(f.parallelogramOffset) : kParallelogramBuckets - 1;
+  c.parallelogram = ((f.hasPlane ? planeBucket(f.planeOffset) : 0) * kSpreadClasses +
+                     spreadClass(f.parallelogramSpread)) *
+                        kParallelogramBuckets +
+                    parallelogram;
+  parallelogramPredictions_ += f.hasParallelogram;
   return true;
 }
 
@@ -220,6 +299,15 @@ CountContext PositionPredictor::countContext(uint32_t vertex, int level) {
   if (!gather(vertex, axis_[size_t(level)], around)) return {};
   ++countPredictions_;
   const Features f = features(around, level);
+  CountContext context = countContextOf(f);
+  if (f.hasParallelogram) {
+    context.parallelogram = parallelogramBucket(f.parallelogramOffset);
+    ++parallelogramPredictions_;
+  }
+  return context;
+}
+
+CountContext PositionPredictor::countContextOf(const Features& f) {
   if (!f.hasPlane) {
     const double c = f.centroidOffset;
     return {c < 0.5 ? 10 : c < 1.5 ? 11 : 12, f.mirrored, f.elongation};

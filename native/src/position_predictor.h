@@ -25,7 +25,14 @@
 //     away from their outside more often than not, so a vertex sits on the
 //     outer side of its neighbours' plane);
 //   - how many triangles the vertex is in (a regular fan's centroid is a
-//     better guess than an irregular one's).
+//     better guess than an irregular one's);
+//   - the parallelogram predictions: each triangle v a b of the vertex and
+//     the triangle b a c across its far edge predict v at a + b − c (the
+//     rule single-rate coders predict with, here from the current
+//     complex); their mean, and their variance, which says how far to trust
+//     it (with their model for cell counts, count_coder.h: bunny −0.50 bits
+//     per vertex, fandisk −0.69, triceratops −0.46, dragon −0.05,
+//     tetrahedral ball −0.24).
 // The configuration is mirrored so that the prediction points to the upper
 // half, which lets the two mirror images share statistics. A one-vertex split
 // mixes three models chosen by these features (mixer.h); the split of a cell
@@ -98,7 +105,8 @@ class PositionPredictor {
     } else {
       const bool bit = mixer_.code(coder, c.mixerSet,
                                    {&models_[size_t(c.joint)], &planeModels_[size_t(c.plane)],
-                                    &centroidModels_[size_t(c.centroid)]},
+                                    &centroidModels_[size_t(c.centroid)],
+                                    &parallelogramModels_[size_t(c.parallelogram)]},
                                    inFirstHalf != c.mirrored);
       first = bit != c.mirrored;
     }
@@ -108,6 +116,11 @@ class PositionPredictor {
     places_[vertex].centre[axis] += first ? -quarter : quarter;
     return first;
   }
+
+  // The split of the triangle's vertex at `position` may have changed its
+  // neighbours across the two edges through that vertex: across() will
+  // search for them again.
+  void forgetAcross(uint32_t triangle, uint32_t position);
 
   bool geometric(int level) const { return size_t(level) < axis_.size(); }
   double inverseHalfWidth(int level) const { return inverseHalfWidths_[size_t(level)]; }
@@ -122,11 +135,13 @@ class PositionPredictor {
   const std::vector<BitModel>& models() const { return models_; }
   const std::vector<BitModel>& planeModels() const { return planeModels_; }
   const std::vector<BitModel>& centroidModels() const { return centroidModels_; }
+  const std::vector<BitModel>& parallelogramModels() const { return parallelogramModels_; }
 
   // Adds the prediction counters to `statistics`.
   void addStatistics(ConnectivityStatistics& statistics) const {
     statistics.countPredictions += countPredictions_;
     statistics.positionPredictions += positionPredictions_;
+    statistics.parallelogramPredictions += parallelogramPredictions_;
   }
 
  private:
@@ -146,7 +161,10 @@ class PositionPredictor {
     double sum[3], normal[3];
     double squaredDistance;
     double squaredAlong;  // of the offsets along the split axis
-    uint32_t count;
+    // The sum of the parallelogram predictions' offsets along the split
+    // axis (see gather()), and of their squares.
+    double parallelogramAlong, parallelogramSquaredAlong;
+    uint32_t count, parallelograms;
     bool oriented;
   };
   // The predictions against the split at `level`, in half widths of the
@@ -158,21 +176,30 @@ class PositionPredictor {
     double centroidOffset = 0;
     double meanSquaredDistance = 0;  // of the neighbours, in squared half widths
     int elongation = 1;              // elongationGroup() (position_predictor.cpp)
-    bool hasPlane = false, mirrored = false;
+    double parallelogramOffset = 0;  // the mean parallelogram prediction's
+    double parallelogramSpread = 0;  // the variance of the predictions, in squared half widths
+    bool hasPlane = false, hasParallelogram = false, mirrored = false;
     bool outsideUp = false;  // an oriented normal points to the upper half
   };
   Features features(const Neighbourhood& around, int level) const;
   // Sums the neighbours of `vertex` (squaredAlong along `axis`); false
   // without any.
-  bool gather(uint32_t vertex, int axis, Neighbourhood& around) const;
+  bool gather(uint32_t vertex, int axis, Neighbourhood& around);
+  // The vertex c of a triangle b a c across the edge a b (wound a b), or
+  // kNoSimplex; `slot` (triangle · 3 + position) names the triangle
+  // v a b whose edge it is, under which the answer is remembered.
+  uint32_t across(uint32_t slot, uint32_t a, uint32_t b);
+  static constexpr uint32_t kUnknown = 0xffffffffu, kNowhere = 0xfffffffeu;
   // The models of a one-vertex split: one for the joint class of all
   // features, one for the plane's alone, one for the centroid's alone,
   // mixed with weights chosen by the neighbours' distance and elongation.
   struct SingleContexts {
-    int joint, plane, centroid, mixerSet;
+    int joint, plane, centroid, parallelogram, mixerSet;
     bool mirrored;
   };
   bool contextsOf(uint32_t vertex, int level, SingleContexts& contexts);
+  // The neighbourhood class of a cell's count from the plane or centroid.
+  static CountContext countContextOf(const Features& f);
 
   std::vector<uint8_t> axis_;                  // split axis per level
   std::vector<std::array<double, 3>> widths_;  // cell width per level and axis
@@ -182,10 +209,17 @@ class PositionPredictor {
   std::vector<double> inverseHalfWidths_;
   std::vector<Place> places_;
   const SimplexStore& store_;
-  std::vector<BitModel> models_, planeModels_, centroidModels_;
-  Mixer<3> mixer_;
+  // Per triangle slot (see across()), the slot of the far vertex c of the
+  // triangle found across the edge opposite the slot's vertex (kNowhere: no
+  // triangle; kUnknown: not searched since the triangle's star changed).
+  // Searching walks a's triangles; a vertex split changes the answer only
+  // for triangles of the split vertex's star (forgetAcross).
+  std::vector<uint32_t> acrossSlots_;
+  std::vector<BitModel> models_, planeModels_, centroidModels_, parallelogramModels_;
+  Mixer<4> mixer_;
   uint64_t countPredictions_ = 0;
   uint64_t positionPredictions_ = 0;
+  uint64_t parallelogramPredictions_ = 0;
 };
 
 }  // namespace kdmesh

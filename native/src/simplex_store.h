@@ -70,6 +70,8 @@ class SimplexStore {
   const uint32_t* vertices(int dimension, uint32_t simplex) const {
     return &pool_[dimension].vertices[size_t(simplex) * size_t(dimension + 1)];
   }
+  // The vertex in an incidence slot (simplex · (dimension + 1) + position).
+  uint32_t vertexInSlot(int dimension, uint32_t slot) const { return pool_[dimension].vertices[slot]; }
   uint8_t& flags(int dimension, uint32_t simplex) { return pool_[dimension].flags[simplex]; }
   uint8_t flags(int dimension, uint32_t simplex) const { return pool_[dimension].flags[simplex]; }
   uint32_t size(int dimension) const { return uint32_t(pool_[dimension].flags.size()); }

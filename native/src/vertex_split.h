@@ -91,7 +91,7 @@ class VertexSplitter {
   // `geometry` knows where the cells are; the split of a cell at a
   // geometric level puts v in its first half and v2 in the second, which
   // predicts where v's edges go.
-  VertexSplitter(SimplexStore& store, const PositionPredictor& geometry)
+  VertexSplitter(SimplexStore& store, PositionPredictor& geometry)
       : store_(store), geometry_(geometry) {
     static_assert(sizeof(edgeModels_) / sizeof(BitModel) == kFamilySize[int(ModelFamily::EdgeCodes)]);
     primeModels(ModelFamily::EdgeCodes, edgeModels());
@@ -147,7 +147,7 @@ class VertexSplitter {
   int voteOnFlip(uint32_t simplex, const std::vector<uint32_t>& candidates, int& voteClass) const;
 
   SimplexStore& store_;
-  const PositionPredictor& geometry_;
+  PositionPredictor& geometry_;
   std::vector<Entry> star_;
   std::vector<double> cosines_, lengths_;  // per edge of the star
   std::vector<uint32_t> codingOrder_;  // star_ indices in the order codes are taken
@@ -323,6 +323,7 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, Ora
     Entry& entry = star_[i];
     const int d = entry.dimension;
     if (entry.code == 2) store_.replaceVertex(d, entry.simplex, v, v2);
+    if (d == 2) geometry_.forgetAcross(entry.simplex, entry.position);
     store_.link(d, entry.simplex, entry.position);
     if (entry.code < 3) continue;
     const uint8_t undecided = d >= 2 ? SimplexStore::kUndecided : 0;

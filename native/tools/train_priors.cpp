@@ -23,7 +23,8 @@ constexpr double kMaxWeight = 256;
 constexpr const char* kNames[kdmesh::kModelFamilies] = {"kOneVertexSplitPriors", "kEdgeCodePriors",
                                                          "kCellCountPriors", "kOneVertexByPlanePriors",
                                                          "kOneVertexByCentroidPriors", "kEdgeCodeByDirectionPriors",
-                                                         "kTriangleCodePriors"};
+                                                         "kTriangleCodePriors", "kOneVertexByParallelogramPriors",
+                                                         "kCellCountByParallelogramPriors"};
 
 }  // namespace
 

@@ -62,12 +62,15 @@ TEST(Connectivity, PredictorsRunAlikeOnBothSides) {
     EXPECT_EQ(theirs.edgeCodesByDirection, mine.edgeCodesByDirection);
     EXPECT_EQ(theirs.countPredictions, mine.countPredictions);
     EXPECT_EQ(theirs.positionPredictions, mine.positionPredictions);
+    EXPECT_EQ(theirs.parallelogramPredictions, mine.parallelogramPredictions);
     EXPECT_EQ(theirs.edgeExpansions, mine.edgeExpansions);
     EXPECT_EQ(theirs.pairedTriangles, mine.pairedTriangles);
     // Surfaces split mostly by edge expansions; tetrahedral meshes have
     // triangles between cut edges.
     if (c.surface) {
       EXPECT_GT(mine.edgeExpansions * 2, mine.vertexSplits);
+      // Most vertices of a closed surface have triangles across their link.
+      EXPECT_GT(mine.parallelogramPredictions * 2, mine.positionPredictions);
     } else {
       EXPECT_GT(mine.pairedTriangles, 0u);
     }
