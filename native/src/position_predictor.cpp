@@ -163,8 +163,6 @@ PositionPredictor::Features PositionPredictor::features(const Neighbourhood& aro
 }
 
 uint32_t PositionPredictor::across(uint32_t slot, uint32_t a, uint32_t b) {
-  if (slot >= acrossSlots_.size())
-    acrossSlots_.resize(std::max<size_t>(size_t(store_.size(2)) * 3, size_t(slot) + 1), kUnknown);
   uint32_t found = acrossSlots_[slot];
   if (found == kUnknown) {
     // In the triangle b a c, wound that way, c follows a and b follows c.
@@ -199,6 +197,8 @@ bool PositionPredictor::gather(uint32_t vertex, int axis, Neighbourhood& around)
   double sumX = 0, sumY = 0, sumZ = 0, normalX = 0, normalY = 0, normalZ = 0, squared = 0, along = 0;
   double parallelogramAlong = 0, parallelogramSquaredAlong = 0;
   uint32_t count = 0, parallelograms = 0;
+  // Room for every triangle slot across() may be asked about.
+  if (acrossSlots_.size() < size_t(store_.size(2)) * 3) acrossSlots_.resize(size_t(store_.size(2)) * 3, kUnknown);
   // Each triangle adds the vertex that follows this one in its winding
   // (around a closed, consistently wound fan, every neighbour once) and the
   // cross product of the offsets of that vertex and the next.
@@ -275,7 +275,8 @@ bool PositionPredictor::contextsOf(uint32_t vertex, int level, SingleContexts& c
   const int scale = scaleClass(f.meanSquaredDistance);
   const int valence = valenceClass(around.count, around.oriented);
   const int centroid = centroidBucket(f.centroidOffset);
-  c.plane = ((f.outsideUp * kScaleClasses + scale) * kTiltClasses + tilt) * kPlaneBuckets + planeBucket(f.planeOffset);
+  const int plane = planeBucket(f.planeOffset);  // 0 without a plane
+  c.plane = ((f.outsideUp * kScaleClasses + scale) * kTiltClasses + tilt) * kPlaneBuckets + plane;
   c.joint = (kJointValence[valence] * kOutsideClasses * kScaleClasses * kTiltClasses * kPlaneBuckets + c.plane) *
                 kCentroidBuckets +
             centroid;
@@ -286,10 +287,8 @@ bool PositionPredictor::contextsOf(uint32_t vertex, int level, SingleContexts& c
   c.mixerSet = (f.elongation * kScaleClasses + scale) * kAgreementClasses + agreement;
   const int parallelogram =
       f.hasParallelogram ? parallelogramBucket(f.parallelogramOffset) : kParallelogramBuckets - 1;
-  c.parallelogram = ((f.hasPlane ? planeBucket(f.planeOffset) : 0) * kSpreadClasses +
-                     spreadClass(f.parallelogramSpread)) *
-                        kParallelogramBuckets +
-                    parallelogram;
+  c.parallelogram =
+      (plane * kSpreadClasses + spreadClass(f.parallelogramSpread)) * kParallelogramBuckets + parallelogram;
   parallelogramPredictions_ += f.hasParallelogram;
   return true;
 }

@@ -8,6 +8,7 @@
 // decoder; `uniform(value, count)` does the same for a value in [0, count).
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <vector>
@@ -29,19 +30,20 @@ struct BitModel {
   uint32_t probabilityOfZero() const { return (uint32_t(fast) + slow) >> 1; }
 
   void update(bool bit) {
-    static constexpr uint8_t kSlowShift[8] = {1, 2, 3, 4, 5, 5, 6, 6};
-    const int slowShift = seen < 64 ? kSlowShift[seen >> 3] : 7;
-    if (seen < 0xffff) ++seen;
+    // The slow rate by observations seen: 1/2 for the first eight, ...,
+    // 1/128 from the 64th on.
+    static constexpr uint8_t kSlowShift[9] = {1, 2, 3, 4, 5, 5, 6, 6, 7};
+    const int slowShift = kSlowShift[std::min<int>(seen, 64) >> 3];
+    seen = uint16_t(seen + (seen < 0xffff));
+    // Keep the slow estimate away from 0 and 1 so every symbol stays
+    // codable; a step towards one bound cannot cross the other.
     if (bit) {
-      fast -= fast >> 4;
-      slow -= slow >> slowShift;
+      fast = uint16_t(fast - (fast >> 4));
+      slow = uint16_t(std::max<int>(slow - (slow >> slowShift), 31));
     } else {
-      fast += (kProbabilityOne - fast) >> 4;
-      slow += (kProbabilityOne - slow) >> slowShift;
+      fast = uint16_t(fast + ((kProbabilityOne - fast) >> 4));
+      slow = uint16_t(std::min<int>(slow + ((kProbabilityOne - slow) >> slowShift), kProbabilityOne - 31));
     }
-    // Keep both away from 0 and 1 so every symbol stays codable.
-    if (slow < 31) slow = 31;
-    if (slow > kProbabilityOne - 31) slow = kProbabilityOne - 31;
   }
 };
 
