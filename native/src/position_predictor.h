@@ -35,7 +35,7 @@
 //     tetrahedral ball −0.24).
 // The configuration is mirrored so that the prediction points to the upper
 // half, which lets the two mirror images share statistics. A one-vertex split
-// mixes three models chosen by these features (mixer.h); the split of a cell
+// mixes four models chosen by these features (mixer.h); the split of a cell
 // of several vertices gets a class for CountCoder.
 #pragma once
 
@@ -176,8 +176,8 @@ class PositionPredictor {
     double centroidOffset = 0;
     double meanSquaredDistance = 0;  // of the neighbours, in squared half widths
     int elongation = 1;              // elongationGroup() (position_predictor.cpp)
-    double parallelogramOffset = 0;  // the mean parallelogram prediction's
-    double parallelogramSpread = 0;  // the variance of the predictions, in squared half widths
+    double parallelogramOffset = 0;  // the parallelogram predictions' mean offset
+    double parallelogramSpread = 0;  // their variance, in squared half widths
     bool hasPlane = false, hasParallelogram = false, mirrored = false;
     bool outsideUp = false;  // an oriented normal points to the upper half
   };
@@ -191,8 +191,10 @@ class PositionPredictor {
   uint32_t across(uint32_t slot, uint32_t a, uint32_t b);
   static constexpr uint32_t kUnknown = 0xffffffffu, kNowhere = 0xfffffffeu;
   // The models of a one-vertex split: one for the joint class of all
-  // features, one for the plane's alone, one for the centroid's alone,
-  // mixed with weights chosen by the neighbours' distance and elongation.
+  // features, one for the plane's alone, one for the centroid's alone, one
+  // for the parallelogram predictions (with the plane's offset), mixed with
+  // weights chosen by the neighbours' distance and elongation and by how
+  // far the parallelogram predictions agree.
   struct SingleContexts {
     int joint, plane, centroid, parallelogram, mixerSet;
     bool mirrored;

@@ -90,7 +90,8 @@ class VertexSplitter {
  public:
   // `geometry` knows where the cells are; the split of a cell at a
   // geometric level puts v in its first half and v2 in the second, which
-  // predicts where v's edges go.
+  // predicts where v's edges go. A split tells `geometry` which triangles
+  // it changed (PositionPredictor::forgetAcross).
   VertexSplitter(SimplexStore& store, PositionPredictor& geometry)
       : store_(store), geometry_(geometry) {
     static_assert(sizeof(edgeModels_) / sizeof(BitModel) == kFamilySize[int(ModelFamily::EdgeCodes)]);
