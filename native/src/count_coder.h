@@ -83,15 +83,15 @@ class CountCoder {
   uint32_t code(Coder& coder, uint32_t population, int level, bool parentOneSided,
                 uint32_t firstHalf, const CountContext& context = {}) {
     const uint32_t coded = codeOrdered(coder, population, level, parentOneSided,
-                                       context.mirrored ? population - firstHalf : firstHalf,
-                                       context.neighbourhoodClass, context.elongation, context.parallelogram);
+                                       context.mirrored ? population - firstHalf : firstHalf, context);
     return context.mirrored ? population - coded : coded;
   }
 
  private:
   template <class Coder>
   uint32_t codeOrdered(Coder& coder, uint32_t population, int level, bool parentOneSided,
-                       uint32_t firstHalf, int neighbourhoodClass, int elongation, int parallelogram) {
+                       uint32_t firstHalf, const CountContext& context) {
+    const int neighbourhoodClass = context.neighbourhoodClass;
     BitModel* models = &models_[(size_t(level) * kParentClasses + parentOneSided) * kContextsPerLevel +
                                 populationOffset(population)];
     // With a neighbourhood class, each decision mixes the class's model with
@@ -102,12 +102,13 @@ class CountCoder {
                                     (population <= kExactPopulations ? populationOffset(population) : kSmallNodes)]
             : nullptr;
     // And with the model of where the parallelogram predictions put the
-    // cell's vertex, by population group (2, 3, 4-7, more); the nodes of
-    // trees deeper than a population of 15 needs share the last.
+    // cell's vertex, by population group (2, 3, 4-7, more) and tree node
+    // (from the 15th on, one model).
     const int populationGroup = population <= 2 ? 0 : population == 3 ? 1 : population <= 7 ? 2 : 3;
     BitModel* byParallelogram =
         neighbourhoodClass > 0
-            ? &parallelogramModels_[size_t(populationGroup * CountContext::kParallelogramBuckets + parallelogram) *
+            ? &parallelogramModels_[size_t(populationGroup * CountContext::kParallelogramBuckets +
+                                           context.parallelogram) *
                                     kParallelogramNodes]
             : nullptr;
     uint32_t low = 0, candidates = population + 1, node = 1;
@@ -117,7 +118,7 @@ class CountCoder {
       const uint32_t lowerHalf = candidates >> 1;
       bool upper = firstHalf - low >= lowerHalf;
       if (byNeighbourhood)
-        upper = mixer_.code(coder, elongation * kNeighbourhoodClasses + neighbourhoodClass,
+        upper = mixer_.code(coder, context.elongation * kNeighbourhoodClasses + neighbourhoodClass,
                             {&byNeighbourhood[node], &models[node],
                              &byParallelogram[std::min(node, kParallelogramNodes - 1)]},
                             upper);
