@@ -9,11 +9,12 @@
 //   - the node of the bisection tree (the decisions taken so far),
 //   - and, in a complex, a class of the cell's neighbourhood
 //     (PositionPredictor::countContext) and where the neighbours'
-//     parallelogram predictions put the cell's vertex, whose models are
-//     mixed with the one above (the latter: bunny −0.02 bits per vertex,
-//     triceratops −0.07). Populations above 15 share one model per class and tree node:
-//     few cells are that large (bunny −0.06 bits per vertex; −0.05 with a
-//     row per bit width of the population, which learns more slowly).
+//     parallelogram predictions put the cell's vertex (bunny −0.02 bits per
+//     vertex, triceratops −0.07), whose models are mixed with the one above.
+//     Populations above 15 share one neighbourhood model per class and tree
+//     node: few cells are that large (bunny −0.06 bits per vertex; −0.05
+//     with a row per bit width of the population, which learns more
+//     slowly).
 // After six decisions the few remaining candidates of a large cell are nearly
 // equiprobable and are coded uniformly.
 #pragma once

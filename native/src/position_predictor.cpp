@@ -159,6 +159,7 @@ PositionPredictor::Features PositionPredictor::features(const Neighbourhood& aro
     f.centroidOffset = -f.centroidOffset;
     f.parallelogramOffset = -f.parallelogramOffset;
   }
+  if (f.hasParallelogram) f.parallelogram = parallelogramBucket(f.parallelogramOffset);
   return f;
 }
 
@@ -285,10 +286,8 @@ bool PositionPredictor::contextsOf(uint32_t vertex, int level, SingleContexts& c
   // within about 1.4 half widths, farther, or no prediction.
   const int agreement = !f.hasParallelogram ? 2 : f.parallelogramSpread < 2 ? 0 : 1;
   c.mixerSet = (f.elongation * kScaleClasses + scale) * kAgreementClasses + agreement;
-  const int parallelogram =
-      f.hasParallelogram ? parallelogramBucket(f.parallelogramOffset) : kParallelogramBuckets - 1;
   c.parallelogram =
-      (plane * kSpreadClasses + spreadClass(f.parallelogramSpread)) * kParallelogramBuckets + parallelogram;
+      (plane * kSpreadClasses + spreadClass(f.parallelogramSpread)) * kParallelogramBuckets + f.parallelogram;
   parallelogramPredictions_ += f.hasParallelogram;
   return true;
 }
@@ -298,11 +297,9 @@ CountContext PositionPredictor::countContext(uint32_t vertex, int level) {
   if (!gather(vertex, axis_[size_t(level)], around)) return {};
   ++countPredictions_;
   const Features f = features(around, level);
+  parallelogramPredictions_ += f.hasParallelogram;
   CountContext context = countContextOf(f);
-  if (f.hasParallelogram) {
-    context.parallelogram = parallelogramBucket(f.parallelogramOffset);
-    ++parallelogramPredictions_;
-  }
+  context.parallelogram = f.parallelogram;
   return context;
 }
 

@@ -178,6 +178,8 @@ class PositionPredictor {
     int elongation = 1;              // elongationGroup() (position_predictor.cpp)
     double parallelogramOffset = 0;  // the parallelogram predictions' mean offset
     double parallelogramSpread = 0;  // their variance, in squared half widths
+    // The offset's bucket (position_predictor.cpp), the last for none.
+    int parallelogram = CountContext::kParallelogramBuckets - 1;
     bool hasPlane = false, hasParallelogram = false, mirrored = false;
     bool outsideUp = false;  // an oriented normal points to the upper half
   };
