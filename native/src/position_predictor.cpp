@@ -2,6 +2,7 @@
 
 #include "model_priors.h"
 
+#include <algorithm>
 #include <cmath>
 
 namespace kdmesh {
@@ -73,12 +74,64 @@ int parallelogramBucket(double t) {
   return countAtMost(t, kBounds);
 }
 
-// The variance of the parallelogram predictions along the split axis, in
-// squared half widths: how far to trust their mean.
-int spreadClass(double variance) {
+// The squared median deviation of the parallelogram predictions along the
+// split axis, in squared half widths: how far to trust their median.
+int spreadClass(double spread) {
   static constexpr double kBounds[kSpreadClasses - 1] = {0.125, 0.25, 0.5, 1, 2, 4, 16, 64};
-  return countAtMost(variance, kBounds);
+  return countAtMost(spread, kBounds);
 }
+
+// The median of `count` sorted values: the middle one, or the mean of the
+// two middle ones.
+double middleOf(const double* sorted, uint32_t count) {
+  const uint32_t half = count / 2;
+  return count % 2 == 1 ? sorted[half] : 0.5 * (sorted[half - 1] + sorted[half]);
+}
+
+// Sorts eight values by a network of comparisons, each a min and a max: no
+// branch on the data, which falls either way at random. Unrolled, the values
+// stay in registers.
+template <size_t kComparisons>
+void sortEight(double (&v)[8], const uint8_t (&pairs)[kComparisons][2]) {
+#pragma GCC unroll 19
+  for (const auto& pair : pairs) {
+    const double low = std::min(v[pair[0]], v[pair[1]]), high = std::max(v[pair[0]], v[pair[1]]);
+    v[pair[0]] = low;
+    v[pair[1]] = high;
+  }
+}
+// Any eight values (Knuth's 19 comparisons).
+constexpr uint8_t kSortEight[19][2] = {{0, 2}, {1, 3}, {4, 6}, {5, 7}, {0, 4}, {1, 5}, {2, 6},
+                                       {3, 7}, {0, 1}, {2, 3}, {4, 5}, {6, 7}, {2, 4}, {3, 5},
+                                       {1, 4}, {3, 6}, {1, 2}, {3, 4}, {5, 6}};
+// Eight values that fall and then rise (Batcher's bitonic merge).
+constexpr uint8_t kMergeValley[12][2] = {{0, 4}, {1, 5}, {2, 6}, {3, 7}, {0, 2}, {1, 3},
+                                         {4, 6}, {5, 7}, {0, 1}, {2, 3}, {4, 5}, {6, 7}};
+
+}  // namespace
+
+void medianAndDeviation(double* values, uint32_t count, double& median, double& deviation) {
+  if (count <= 8) {
+    // Most vertices of a surface have at most eight triangles: sorted as
+    // eight, the rest infinite.
+    double sorted[8];
+    for (uint32_t i = 0; i < 8; ++i) sorted[i] = i < count ? values[i] : HUGE_VAL;
+    sortEight(sorted, kSortEight);
+    median = middleOf(sorted, count);
+    // The deviations of sorted values fall to the median and rise after it.
+    for (uint32_t i = 0; i < 8; ++i) sorted[i] = i < count ? std::fabs(sorted[i] - median) : HUGE_VAL;
+    sortEight(sorted, kMergeValley);
+    deviation = middleOf(sorted, count);
+    return;
+  }
+  std::sort(values, values + count);
+  median = middleOf(values, count);
+  for (uint32_t i = 0; i < count; ++i) values[i] = std::fabs(values[i] - median);
+  std::sort(values, values + count);
+  deviation = middleOf(values, count);
+}
+
+namespace {
 
 int centroidBucket(double t) {
   static constexpr double kBounds[kCentroidBuckets - 1] = {-2, -1, -0.5, -0.25, 0, 0.25, 0.5, 1, 2};
@@ -145,11 +198,9 @@ PositionPredictor::Features PositionPredictor::features(const Neighbourhood& aro
     f.hasPlane = true;
   }
   if (around.parallelograms > 0) {
-    const double inverseCount = 1.0 / double(around.parallelograms);
-    const double mean = around.parallelogramAlong * inverseCount;
-    f.parallelogramOffset = mean * inverseHalfWidth;
-    f.parallelogramSpread =
-        (around.parallelogramSquaredAlong * inverseCount - mean * mean) * (inverseHalfWidth * inverseHalfWidth);
+    f.parallelogramOffset = around.parallelogramMedian * inverseHalfWidth;
+    const double deviation = around.parallelogramDeviation * inverseHalfWidth;
+    f.parallelogramSpread = deviation * deviation;
     f.hasParallelogram = true;
   }
   f.mirrored = (f.hasPlane ? f.planeOffset : f.centroidOffset) < 0;
@@ -196,10 +247,10 @@ bool PositionPredictor::gather(uint32_t vertex, int axis, Neighbourhood& around)
   const double* at = places_[vertex].centre;
   const double atX = at[0], atY = at[1], atZ = at[2], atAxis = at[axis];
   double sumX = 0, sumY = 0, sumZ = 0, normalX = 0, normalY = 0, normalZ = 0, squared = 0, along = 0;
-  double parallelogramAlong = 0, parallelogramSquaredAlong = 0;
   uint32_t count = 0, parallelograms = 0;
   // Room for every triangle slot across() may be asked about.
   if (acrossSlots_.size() < size_t(store_.size(2)) * 3) acrossSlots_.resize(size_t(store_.size(2)) * 3, kUnknown);
+  double* predictions = predictions_.data();
   // Each triangle adds the vertex that follows this one in its winding
   // (around a closed, consistently wound fan, every neighbour once) and the
   // cross product of the offsets of that vertex and the next.
@@ -223,17 +274,20 @@ bool PositionPredictor::gather(uint32_t vertex, int axis, Neighbourhood& around)
     ++count;
     // The parallelogram rule: on a flat, evenly sampled surface v a c b is
     // a parallelogram, c being the far vertex of the triangle across a b;
-    // summed only along the split axis, where the features look.
+    // listed only along the split axis, where the features look.
     if (const uint32_t far = across(triangle * 3 + position, next, afterNext); far != kNoSimplex) {
-      const double predicted = aAlong + (b[axis] - atAxis) - (places_[far].centre[axis] - atAxis);
-      parallelogramAlong += predicted;
-      parallelogramSquaredAlong += predicted * predicted;
-      ++parallelograms;
+      if (parallelograms == predictions_.size()) {
+        predictions_.resize(std::max<size_t>(16, 2 * predictions_.size()));
+        predictions = predictions_.data();
+      }
+      predictions[parallelograms++] = aAlong + (b[axis] - atAxis) - (places_[far].centre[axis] - atAxis);
     }
   });
   if (count > 0) {
-    around = {{sumX, sumY, sumZ}, {normalX, normalY, normalZ}, squared, along,
-              parallelogramAlong, parallelogramSquaredAlong, count, parallelograms, true};
+    double median = 0, deviation = 0;
+    if (parallelograms > 0) medianAndDeviation(predictions, parallelograms, median, deviation);
+    around = {{sumX, sumY, sumZ}, {normalX, normalY, normalZ}, squared, along, median, deviation, count,
+              parallelograms, true};
     return true;
   }
   // No triangle: the other ends of the edges.

@@ -29,10 +29,13 @@
 //   - the parallelogram predictions: each triangle v a b of the vertex and
 //     the triangle b a c across its far edge predict v at a + b − c (the
 //     rule single-rate coders predict with, here from the current
-//     complex); their mean, and their variance, which says how far to trust
-//     it (with their model for cell counts, count_coder.h: bunny −0.50 bits
-//     per vertex, fandisk −0.69, triceratops −0.46, dragon −0.05,
-//     tetrahedral ball −0.24).
+//     complex); their median, and their median absolute deviation, which
+//     says how far to trust it (with their model for cell counts,
+//     count_coder.h, and as mean and variance: bunny −0.50 bits per vertex,
+//     fandisk −0.69, triceratops −0.46, dragon −0.05, tetrahedral ball
+//     −0.24; the median and its deviation, robust against the
+//     parallelograms that span a crease or a fold, took another −0.26,
+//     −0.26 and −0.25 on the first three).
 // The configuration is mirrored so that the prediction points to the upper
 // half, which lets the two mirror images share statistics. A one-vertex split
 // mixes four models chosen by these features (mixer.h); the split of a cell
@@ -71,6 +74,11 @@ int countAtMost(double t, const double (&bounds)[kCount]) {
   for (const double bound : bounds) below += t >= bound;
   return below;
 }
+
+// The median of values[0..count), count > 0, and the median of their
+// absolute deviations from it (reordering the values). Values, not
+// positions, are what count: encoder and decoder agree whatever the sort.
+void medianAndDeviation(double* values, uint32_t count, double& median, double& deviation);
 
 class PositionPredictor {
  public:
@@ -161,9 +169,9 @@ class PositionPredictor {
     double sum[3], normal[3];
     double squaredDistance;
     double squaredAlong;  // of the offsets along the split axis
-    // The sum of the parallelogram predictions' offsets along the split
-    // axis (see gather()), and of their squares.
-    double parallelogramAlong, parallelogramSquaredAlong;
+    // The median of the parallelogram predictions' offsets along the split
+    // axis (see gather()), and their median absolute deviation from it.
+    double parallelogramMedian, parallelogramDeviation;
     uint32_t count, parallelograms;
     bool oriented;
   };
@@ -176,8 +184,8 @@ class PositionPredictor {
     double centroidOffset = 0;
     double meanSquaredDistance = 0;  // of the neighbours, in squared half widths
     int elongation = 1;              // elongationGroup() (position_predictor.cpp)
-    double parallelogramOffset = 0;  // the parallelogram predictions' mean offset
-    double parallelogramSpread = 0;  // their variance, in squared half widths
+    double parallelogramOffset = 0;  // the parallelogram predictions' median offset
+    double parallelogramSpread = 0;  // their squared median deviation, in squared half widths
     // The offset's bucket (position_predictor.cpp), the last for none.
     int parallelogram = CountContext::kParallelogramBuckets - 1;
     bool hasPlane = false, hasParallelogram = false, mirrored = false;
@@ -219,6 +227,8 @@ class PositionPredictor {
   // Searching walks a's triangles; a vertex split changes the answer only
   // for triangles of the split vertex's star (forgetAcross).
   std::vector<uint32_t> acrossSlots_;
+  // The parallelogram predictions of one gather(), and their deviations.
+  std::vector<double> predictions_;
   std::vector<BitModel> models_, planeModels_, centroidModels_, parallelogramModels_;
   Mixer<4> mixer_;
   uint64_t countPredictions_ = 0;
