@@ -23,7 +23,9 @@ const throttle = option('--throttle', 10000);
 const runs = option('--runs', 1);
 const models = mkdtempSync(join(tmpdir(), 'kdmesh-browser-bench-'));
 const dragon = join(root, 'build', 'models', 'dragon_vrip.ply');
-execFileSync(join(root, 'build', 'kdmesh'), ['encode', dragon, '-o', join(models, 'dragon.kdm'), '--bits', '12', '-q']);
+// The CLI that bench/run.sh builds alongside the WebAssembly decoder it
+// rebuilds: build/'s may be older, and its streams of another format version.
+execFileSync(join(root, 'build-bench', 'kdmesh'), ['encode', dragon, '-o', join(models, 'dragon.kdm'), '--bits', '12', '-q']);
 execFileSync('draco_encoder', ['-i', dragon, '-o', join(models, 'dragon.drc'), '-qp', '12', '-cl', '10'], { stdio: 'ignore' });
 
 const server = await startServer({ port: 0, root: models, host: '127.0.0.1' });
