@@ -10,7 +10,7 @@
 
 namespace kdmesh {
 
-constexpr uint16_t kFormatVersion = 7;
+constexpr uint16_t kFormatVersion = 8;
 
 void writeHeader(const Header& header, uint8_t* out /* kHeaderBytes */);
 // Parses and validates a header: magic, version, checksum and every field's

@@ -53,7 +53,11 @@ class CountCoder {
   // `neighbourhoods`: code() may be given neighbourhood classes (streams
   // with connectivity).
   CountCoder(int levels, bool neighbourhoods)
-      : levels_(levels < 1 ? 1 : levels), mixer_(CountContext::kElongationGroups * kNeighbourhoodClasses, {45875, 19661, 19661}) {
+      : levels_(levels < 1 ? 1 : levels),
+        mixer_(CountContext::kElongationGroups * kNeighbourhoodClasses, mixerPriors(MixerFamily::CellCounts)) {
+    static_assert(size_t(CountContext::kElongationGroups) * kNeighbourhoodClasses ==
+                      kMixerSets[int(MixerFamily::CellCounts)] &&
+                  kMixerInputs[int(MixerFamily::CellCounts)] == 3);
     models_.resize(size_t(levels_) * kParentClasses * kContextsPerLevel);
     static_assert(size_t(kNeighbourhoodClasses) * kNeighbourhoodNodes == kFamilySize[int(ModelFamily::CellCounts)]);
     if (neighbourhoods) {
@@ -68,6 +72,7 @@ class CountCoder {
 
   const std::vector<BitModel>& neighbourhoodModels() const { return neighbourhoodModels_; }
   const std::vector<BitModel>& parallelogramModels() const { return parallelogramModels_; }
+  const Mixer<3>& mixer() const { return mixer_; }
 
   // The count of a one-vertex cell, 1 when the vertex is in the first half;
   // the same model as code() with population 1, in a loop-free form.

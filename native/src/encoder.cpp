@@ -328,6 +328,14 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
     keep(ModelFamily::EdgeCodes, splitter.edgeModels());
     keep(ModelFamily::EdgeCodesByDirection, splitter.edgeDirectionModels());
     keep(ModelFamily::TriangleCodes, splitter.triangleModels());
+    auto keepMixer = [&](MixerFamily family, const auto& mixer) {
+      std::vector<int32_t>& weights = finalModels->mixerWeights[int(family)];
+      weights.clear();
+      for (const auto& set : mixer.weights()) weights.insert(weights.end(), set.begin(), set.end());
+      finalModels->mixerUses[int(family)] = mixer.uses();
+    };
+    keepMixer(MixerFamily::OneVertexSplits, predictor.mixer());
+    keepMixer(MixerFamily::CellCounts, counts.mixer());
   }
 
   predictor.addStatistics(result.statistics);

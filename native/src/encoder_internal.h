@@ -12,6 +12,10 @@ namespace kdmesh {
 
 struct TrainedModels {
   std::array<std::vector<BitModel>, kModelFamilies> families;  // empty for point clouds
+  // Per mixer family, the final weights (kMixerSets × kMixerInputs) and how
+  // often each weight vector was used.
+  std::array<std::vector<int32_t>, kMixerFamilies> mixerWeights;
+  std::array<std::vector<uint32_t>, kMixerFamilies> mixerUses;
 };
 
 EncodeResult encode(const Complex& complex, const EncodeOptions& options, TrainedModels* finalModels);

@@ -50,16 +50,26 @@ inline constexpr StretchTable kStretchTable{};
 
 inline int Logistic::stretch(int p) { return kStretchTable.values[size_t(p)]; }
 
-// Mixes kInputs models with one of `sets` weight vectors, which start at
-// `initial` (in units of 2^-16).
+// Mixes kInputs models with one of `sets` weight vectors (in units of
+// 2^-16), which all start at `initial`, or start at `sets` × kInputs values
+// given vector by vector (learned offline: model_priors.h).
 template <int kInputs>
 class Mixer {
  public:
-  Mixer(int sets, const std::array<int32_t, kInputs>& initial) : weights_(size_t(sets), initial) {}
+  Mixer(int sets, const std::array<int32_t, kInputs>& initial) : weights_(size_t(sets), initial), uses_(size_t(sets)) {}
+  Mixer(int sets, const int32_t* initial) : weights_(size_t(sets)), uses_(size_t(sets)) {
+    for (auto& set : weights_)
+      for (int32_t& weight : set) weight = *initial++;
+  }
+
+  const std::vector<std::array<int32_t, kInputs>>& weights() const { return weights_; }
+  // How many bits each weight vector has mixed.
+  const std::vector<uint32_t>& uses() const { return uses_; }
 
   // P(bit == 0) in units of 2^-15 for the coder.
   uint32_t mix(int set, const std::array<BitModel*, kInputs>& inputs) {
     set_ = set;
+    ++uses_[size_t(set)];
     int64_t dot = 0;
     for (int i = 0; i < kInputs; ++i) {
       const int p = int(inputs[size_t(i)]->probabilityOfZero() >> 3);
@@ -91,6 +101,7 @@ class Mixer {
 
  private:
   std::vector<std::array<int32_t, kInputs>> weights_;
+  std::vector<uint32_t> uses_;
   std::array<int, kInputs> stretched_{};
   int mixed_ = 2048, set_ = 0;
 };

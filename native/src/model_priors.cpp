@@ -1,5 +1,7 @@
 #include "model_priors.h"
 
+#include <iterator>
+
 namespace kdmesh {
 namespace {
 
@@ -7,8 +9,12 @@ namespace {
 // kOneVertexByPlanePriors, kOneVertexByCentroidPriors,
 // kEdgeCodeByDirectionPriors, kTriangleCodePriors,
 // kOneVertexByParallelogramPriors, kCellCountByParallelogramPriors: P(bit == 0) in units of
-// 2^-15, one per model, run-length coded (model_priors.h).
+// 2^-15, one per model, run-length coded (model_priors.h);
+// kOneVertexMixerPriors, kCellCountMixerPriors: starting mixer weights.
 #include "model_priors.inc"
+
+static_assert(std::size(kOneVertexMixerPriors) == kMixerSets[0] * kMixerInputs[0]);
+static_assert(std::size(kCellCountMixerPriors) == kMixerSets[1] * kMixerInputs[1]);
 
 // How many models a run-length coded family primes.
 template <size_t kCoded>
@@ -44,6 +50,10 @@ constexpr CodedFamily codedFamily(const uint16_t (&coded)[kCoded]) {
 }
 
 }  // namespace
+
+const int32_t* mixerPriors(MixerFamily family) {
+  return family == MixerFamily::OneVertexSplits ? kOneVertexMixerPriors : kCellCountMixerPriors;
+}
 
 void primeModels(ModelFamily family, BitModel* models) {
   static constexpr CodedFamily kPriors[kModelFamilies] = {

@@ -1,4 +1,5 @@
-// Starting probabilities for the adaptive models that have many contexts.
+// Starting probabilities for the adaptive models that have many contexts,
+// and starting weights for two mixers.
 //
 // A context seen a few times in a small model codes its first symbols near
 // 1/2 while it learns; the statistics of these contexts (where an edge goes
@@ -41,6 +42,19 @@ constexpr uint16_t kPriorRunMarker = 0;
 // As many observations as a prior is worth: the slow estimator then starts
 // at a moderate rate and still follows the model at hand.
 constexpr uint16_t kPriorObservations = 24;
+
+// The mixers whose starting weights are learned the same way (the final
+// weights of each weight vector, averaged over the training meshes by how
+// often the vector was used): a small model's mixer codes many of its bits
+// before its weights have moved far from any fixed start (triceratops −0.06
+// bits per vertex, fandisk −0.02).
+enum class MixerFamily { OneVertexSplits, CellCounts };
+constexpr int kMixerFamilies = 2;
+constexpr std::array<size_t, kMixerFamilies> kMixerSets = {45, 39};
+constexpr std::array<size_t, kMixerFamilies> kMixerInputs = {4, 3};
+// The starting weights of a mixer family: kMixerSets × kMixerInputs values,
+// weight vector by weight vector, in units of 2^-16.
+const int32_t* mixerPriors(MixerFamily family);
 
 // Sets `models` (kFamilySize of the family) to the family's priors, each
 // held with the confidence of kPriorObservations observations.

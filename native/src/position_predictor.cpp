@@ -148,8 +148,7 @@ PositionPredictor::PositionPredictor(const SplitSchedule& schedule, const Simple
       planeModels_(size_t(kOutsideClasses) * kScaleClasses * kTiltClasses * kPlaneBuckets),
       centroidModels_(size_t(kValenceClasses) * kScaleClasses * kCentroidBuckets),
       parallelogramModels_(size_t(kPlaneBuckets) * kSpreadClasses * kParallelogramBuckets),
-      // The joint model is the sharpest; the others help while it learns.
-      mixer_(kElongationGroups * kScaleClasses * kAgreementClasses, {39322, 19661, 19661, 19661}) {
+      mixer_(kElongationGroups * kScaleClasses * kAgreementClasses, mixerPriors(MixerFamily::OneVertexSplits)) {
   static_assert(size_t(kJointValenceClasses) * kOutsideClasses * kScaleClasses * kTiltClasses * kPlaneBuckets *
                     kCentroidBuckets ==
                 kFamilySize[int(ModelFamily::OneVertexSplits)]);
@@ -159,6 +158,9 @@ PositionPredictor::PositionPredictor(const SplitSchedule& schedule, const Simple
                 kFamilySize[int(ModelFamily::OneVertexByCentroid)]);
   static_assert(size_t(kPlaneBuckets) * kSpreadClasses * kParallelogramBuckets ==
                 kFamilySize[int(ModelFamily::OneVertexByParallelogram)]);
+  static_assert(size_t(kElongationGroups) * kScaleClasses * kAgreementClasses ==
+                    kMixerSets[int(MixerFamily::OneVertexSplits)] &&
+                kMixerInputs[int(MixerFamily::OneVertexSplits)] == 4);
   primeModels(ModelFamily::OneVertexSplits, models_.data());
   primeModels(ModelFamily::OneVertexByPlane, planeModels_.data());
   primeModels(ModelFamily::OneVertexByCentroid, centroidModels_.data());

@@ -144,6 +144,7 @@ class PositionPredictor {
   const std::vector<BitModel>& planeModels() const { return planeModels_; }
   const std::vector<BitModel>& centroidModels() const { return centroidModels_; }
   const std::vector<BitModel>& parallelogramModels() const { return parallelogramModels_; }
+  const Mixer<4>& mixer() const { return mixer_; }
 
   // Adds the prediction counters to `statistics`.
   void addStatistics(ConnectivityStatistics& statistics) const {

@@ -2,7 +2,9 @@
 // training mesh at 12 bits and averages, model by model, the final
 // probability of the slow estimator, weighted by how often the model was
 // used in that mesh (capped, so that no mesh dominates), then writes
-// model_priors.inc. Models no mesh used start at 1/2.
+// model_priors.inc. Models no mesh used start at 1/2. The mixers' starting
+// weights are averaged the same way, weight vector by weight vector; one
+// that no mesh used keeps its compiled value.
 //
 // Learning starts from the priors compiled in, so a retrained family moves
 // the others' final states too; `--only` retrains the named families (array
@@ -10,6 +12,7 @@
 //
 //   kdmesh_train_priors [--only NAMES] OUTPUT.inc MESH...   (see scripts/train-priors.sh)
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -20,20 +23,23 @@
 namespace {
 
 constexpr double kMaxWeight = 256;
-constexpr const char* kNames[kdmesh::kModelFamilies] = {"kOneVertexSplitPriors", "kEdgeCodePriors",
-                                                         "kCellCountPriors", "kOneVertexByPlanePriors",
-                                                         "kOneVertexByCentroidPriors", "kEdgeCodeByDirectionPriors",
-                                                         "kTriangleCodePriors", "kOneVertexByParallelogramPriors",
-                                                         "kCellCountByParallelogramPriors"};
+constexpr double kMaxMixerUses = 2048;  // a mixer vector learns more slowly than a model
+constexpr int kFamilies = kdmesh::kModelFamilies + kdmesh::kMixerFamilies;
+constexpr const char* kNames[kFamilies] = {"kOneVertexSplitPriors", "kEdgeCodePriors",
+                                           "kCellCountPriors", "kOneVertexByPlanePriors",
+                                           "kOneVertexByCentroidPriors", "kEdgeCodeByDirectionPriors",
+                                           "kTriangleCodePriors", "kOneVertexByParallelogramPriors",
+                                           "kCellCountByParallelogramPriors", "kOneVertexMixerPriors",
+                                           "kCellCountMixerPriors"};
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  std::vector<bool> retrain(kdmesh::kModelFamilies, true);
+  std::vector<bool> retrain(kFamilies, true);
   std::string only;
   if (argc > 2 && std::string(argv[1]) == "--only") {
     only = argv[2];
-    for (int f = 0; f < kdmesh::kModelFamilies; ++f)
+    for (int f = 0; f < kFamilies; ++f)
       retrain[size_t(f)] = ("," + only + ",").find("," + std::string(kNames[f]) + ",") != std::string::npos;
     if (std::count(retrain.begin(), retrain.end(), true) == 0) {
       std::fprintf(stderr, "--only %s: no such family (names as in model_priors.inc)\n", argv[2]);
@@ -50,6 +56,12 @@ int main(int argc, char** argv) {
   for (int f = 0; f < kdmesh::kModelFamilies; ++f) {
     sum[size_t(f)].assign(kdmesh::kFamilySize[size_t(f)], 0);
     weight[size_t(f)].assign(kdmesh::kFamilySize[size_t(f)], 0);
+  }
+  // Per mixer family: weighted sums of each weight, and the weight of each vector.
+  std::vector<std::vector<double>> mixerSum(kdmesh::kMixerFamilies), mixerWeight(kdmesh::kMixerFamilies);
+  for (int f = 0; f < kdmesh::kMixerFamilies; ++f) {
+    mixerSum[size_t(f)].assign(kdmesh::kMixerSets[size_t(f)] * kdmesh::kMixerInputs[size_t(f)], 0);
+    mixerWeight[size_t(f)].assign(kdmesh::kMixerSets[size_t(f)], 0);
   }
   for (int i = 2; i < argc; ++i) {
     kdmesh::Complex complex;
@@ -77,6 +89,15 @@ int main(int argc, char** argv) {
         sum[size_t(f)][m] += used * model.slow;
         weight[size_t(f)][m] += used;
       }
+    for (int f = 0; f < kdmesh::kMixerFamilies; ++f) {
+      const size_t inputs = kdmesh::kMixerInputs[size_t(f)];
+      for (size_t set = 0; set < kdmesh::kMixerSets[size_t(f)]; ++set) {
+        const double used = std::min<double>(kMaxMixerUses, models.mixerUses[size_t(f)][set]);
+        for (size_t i = 0; i < inputs; ++i)
+          mixerSum[size_t(f)][set * inputs + i] += used * models.mixerWeights[size_t(f)][set * inputs + i];
+        mixerWeight[size_t(f)][set] += used;
+      }
+    }
   }
   std::FILE* out = std::fopen(argv[1], "w");
   if (!out) {
@@ -110,6 +131,18 @@ int main(int argc, char** argv) {
     std::fprintf(out, "constexpr uint16_t %s[%zu] = {", kNames[f], coded.size());
     for (size_t i = 0; i < coded.size(); ++i)
       std::fprintf(out, "%s%s%d", i ? "," : "", i % 16 == 0 ? "\n    " : " ", coded[i]);
+    std::fprintf(out, "};\n");
+  }
+  for (int f = 0; f < kdmesh::kMixerFamilies; ++f) {
+    const size_t inputs = kdmesh::kMixerInputs[size_t(f)], values = kdmesh::kMixerSets[size_t(f)] * inputs;
+    const int32_t* compiled = kdmesh::mixerPriors(kdmesh::MixerFamily(f));
+    const bool learn = retrain[size_t(kdmesh::kModelFamilies + f)];
+    std::fprintf(out, "constexpr int32_t %s[%zu] = {", kNames[kdmesh::kModelFamilies + f], values);
+    for (size_t i = 0; i < values; ++i) {
+      const double w = mixerWeight[size_t(f)][i / inputs];
+      const long weight = learn && w > 0 ? std::lround(mixerSum[size_t(f)][i] / w) : long(compiled[i]);
+      std::fprintf(out, "%s%s%ld", i ? "," : "", i % inputs == 0 ? "\n    " : " ", weight);
+    }
     std::fprintf(out, "};\n");
   }
   return std::fclose(out) == 0 ? 0 : 1;

@@ -42,5 +42,26 @@ TEST(Mixer, LearnsToTrustTheInformativeInput) {
   EXPECT_LT(p0, uint32_t(0.95 * kProbabilityOne));
 }
 
+// Learned starting weights come vector by vector; each vector counts its
+// uses, which is what training averages them by.
+TEST(Mixer, StartsFromGivenWeightsAndCountsUses) {
+  const int32_t learned[6] = {1 << 16, 0, 0, 1 << 16, 1 << 15, 1 << 15};
+  Mixer<2> mixer(3, learned);
+  ASSERT_EQ(mixer.weights().size(), 3u);
+  EXPECT_EQ(mixer.weights()[1][1], 1 << 16);
+  EXPECT_EQ(mixer.weights()[2][0], 1 << 15);
+  BitModel sure, unsure;
+  sure.fast = sure.slow = uint16_t(0.95 * kProbabilityOne);
+  // Vector 0 follows the first input alone, vector 1 the second.
+  EXPECT_GT(mixer.mix(0, {&sure, &unsure}), uint32_t(0.9 * kProbabilityOne));
+  mixer.update(false);
+  EXPECT_NEAR(double(mixer.mix(1, {&sure, &unsure})), 0.5 * kProbabilityOne, 0.02 * kProbabilityOne);
+  mixer.update(false);
+  mixer.mix(1, {&sure, &unsure});
+  EXPECT_EQ(mixer.uses()[0], 1u);
+  EXPECT_EQ(mixer.uses()[1], 2u);
+  EXPECT_EQ(mixer.uses()[2], 0u);
+}
+
 }  // namespace
 }  // namespace kdmesh::test
