@@ -63,7 +63,9 @@ class Mixer {
   }
 
   const std::vector<std::array<int32_t, kInputs>>& weights() const { return weights_; }
-  // How many bits each weight vector has mixed.
+  // How many bits each weight vector has mixed (what training averages the
+  // learned starting weights by; the count costs no measurable decoding
+  // time: bunny 1.551 G instructions with it, 1.555 G without).
   const std::vector<uint32_t>& uses() const { return uses_; }
 
   // P(bit == 0) in units of 2^-15 for the coder.

@@ -76,7 +76,7 @@ int countAtMost(double t, const double (&bounds)[kCount]) {
 }
 
 // The median of values[0..count), count > 0, and the median of their
-// absolute deviations from it (reordering the values). Values, not
+// absolute deviations from it (the values may be reordered). Values, not
 // positions, are what count: encoder and decoder agree whatever the sort.
 void medianAndDeviation(double* values, uint32_t count, double& median, double& deviation);
 

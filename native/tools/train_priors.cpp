@@ -23,7 +23,9 @@
 namespace {
 
 constexpr double kMaxWeight = 256;
-constexpr double kMaxMixerUses = 2048;  // a mixer vector learns more slowly than a model
+// A weight vector is used thousands of times in a mesh, far more than a
+// model; capped too, so that no mesh dominates.
+constexpr double kMaxMixerUses = 2048;
 constexpr int kFamilies = kdmesh::kModelFamilies + kdmesh::kMixerFamilies;
 constexpr const char* kNames[kFamilies] = {"kOneVertexSplitPriors", "kEdgeCodePriors",
                                            "kCellCountPriors", "kOneVertexByPlanePriors",
