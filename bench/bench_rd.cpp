@@ -156,7 +156,7 @@ int main(int argc, char** argv) {
   const NearestPoint nearFinal(finalSamples, cell);
 
   std::printf("bytes,vertices,mean_error,max_error,hausdorff\n");
-  const double first = double(kdmesh::kHeaderBytes + kdmesh::kChunkFrameBytes + 16), last = double(bytes.size());
+  const double first = double(kdmesh::kMaxHeaderBytes + 16), last = double(bytes.size());
   for (int s = 0; s < samples; ++s) {
     const size_t cut = size_t(std::llround(first * std::pow(last / first, double(s) / (samples - 1))));
     kdmesh::Decoder decoder;

@@ -133,7 +133,7 @@ export class Decoder {
     this.#check(m._kdm_finish(this.#handle));
   }
 
-  /** Header fields once its 96 bytes have arrived, else null. */
+  /** Header fields once the header (at most 87 bytes) has arrived, else null. */
   get header() {
     const m = this.#live();
     if (!m._kdm_has_header(this.#handle)) return null;

@@ -41,6 +41,6 @@ int Header::axisBits(int axis) const {
 
 int Header::depth() const { return axisBits(0) + axisBits(1) + axisBits(2); }
 
-uint64_t Header::totalBytes() const { return kHeaderBytes + bodyBytes; }
+uint64_t Header::totalBytes() const { return headerBytes + bodyBytes; }
 
 }  // namespace kdmesh

@@ -10,26 +10,13 @@ namespace kdmesh {
 namespace {
 
 constexpr uint8_t kMagic[4] = {0x89, 'K', 'D', 'M'};
-
-// Field offsets of the header (docs/FORMAT.md).
-enum : size_t {
-  kOffMagic = 0,
-  kOffVersion = 4,
-  kOffHeaderBytes = 6,
-  kOffQuantization = 8,
-  kOffBits = 9,
-  kOffMaxDimension = 10,
-  kOffReserved = 11,
-  kOffFlags = 12,
-  kOffVertexCount = 16,
-  kOffSimplexCounts = 20,
-  kOffGridMax = 36,
-  kOffQuantParams = 48,
-  kOffBodyBytes = 80,
-  kOffChunkCount = 88,
-  kOffChecksum = 92,
-};
-static_assert(kOffChecksum + 4 == kHeaderBytes, "header layout");
+constexpr size_t kOffVersion = 4, kOffHeaderBytes = 6;
+static_assert(kHeaderPrefixBytes == kOffHeaderBytes + 1, "header prefix");
+// The fixed bytes, ten 32-bit varints (the body size's has at most 9 bytes),
+// grid parameters (float32 mode's are three 32-bit varints) and checksum.
+static_assert(kMaxHeaderBytes == kHeaderPrefixBytes + 2 + 9 * 5 + 9 + 20 + 4, "header size");
+// The mode byte: quantization in bits 0-1, the highest dimension in bits 2-3.
+constexpr uint8_t kModeReserved = 0xf0;
 
 void put16(uint8_t* p, uint16_t v) {
   p[0] = uint8_t(v);
@@ -38,23 +25,58 @@ void put16(uint8_t* p, uint16_t v) {
 void put32(uint8_t* p, uint32_t v) {
   for (int i = 0; i < 4; ++i) p[i] = uint8_t(v >> (8 * i));
 }
-void put64(uint8_t* p, uint64_t v) {
-  for (int i = 0; i < 8; ++i) p[i] = uint8_t(v >> (8 * i));
-}
-void putDouble(uint8_t* p, double d) {
-  uint64_t v;
-  std::memcpy(&v, &d, 8);
-  put64(p, v);
-}
 uint16_t get16(const uint8_t* p) { return uint16_t(p[0] | p[1] << 8); }
 uint32_t get32(const uint8_t* p) {
   return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
 }
-uint64_t get64(const uint8_t* p) { return uint64_t(get32(p)) | uint64_t(get32(p + 4)) << 32; }
-double getDouble(const uint8_t* p) {
-  const uint64_t v = get64(p);
+
+// Unsigned LEB128: seven bits per byte, low first, the high bit set on every
+// byte but the last.
+size_t putVarint(uint8_t* p, uint64_t v) {
+  size_t n = 0;
+  for (; v >= 0x80; v >>= 7) p[n++] = uint8_t(v | 0x80);
+  p[n++] = uint8_t(v);
+  return n;
+}
+
+// Reads a varint of at most `maxBytes` bytes from [at, end); false if it
+// runs past `end`, is longer, or exceeds `limit`.
+bool getVarint(const uint8_t*& at, const uint8_t* end, size_t maxBytes, uint64_t limit, uint64_t& v) {
+  v = 0;
+  for (size_t i = 0; i < maxBytes && at < end; ++i) {
+    const uint8_t byte = *at++;
+    v |= uint64_t(byte & 0x7f) << (7 * i);
+    if (!(byte & 0x80)) return v <= limit;
+  }
+  return false;
+}
+
+// IEEE-754 values as the little-endian bytes of their bit patterns.
+void putFloat32(uint8_t*& p, float f) {
+  uint32_t bits;
+  std::memcpy(&bits, &f, 4);
+  put32(p, bits);
+  p += 4;
+}
+void putFloat64(uint8_t*& p, double d) {
+  uint64_t bits;
+  std::memcpy(&bits, &d, 8);
+  put32(p, uint32_t(bits));
+  put32(p + 4, uint32_t(bits >> 32));
+  p += 8;
+}
+float getFloat32(const uint8_t*& p) {
+  const uint32_t bits = get32(p);
+  p += 4;
+  float f;
+  std::memcpy(&f, &bits, 4);
+  return f;
+}
+double getFloat64(const uint8_t*& p) {
+  const uint64_t bits = uint64_t(get32(p)) | uint64_t(get32(p + 4)) << 32;
+  p += 8;
   double d;
-  std::memcpy(&d, &v, 8);
+  std::memcpy(&d, &bits, 8);
   return d;
 }
 
@@ -102,7 +124,7 @@ Status validate(const Header& h, const DecoderLimits& limits) {
                          "stream has " + std::to_string(simplices) +
                              " simplices, more than the decoder limit of " +
                              std::to_string(limits.maxSimplices));
-  if (h.bodyBytes < uint64_t(h.chunkCount) * kChunkFrameBytes ||
+  if (h.bodyBytes < uint64_t(h.chunkCount) * (2 + kChunkChecksumBytes) ||
       (h.chunkCount == 0) != (h.bodyBytes == 0))
     return corrupt("chunk count does not fit the body size");
   if (h.chunkCount == 0 && h.depth() != 0) return corrupt("stream has no chunks");
@@ -111,55 +133,78 @@ Status validate(const Header& h, const DecoderLimits& limits) {
 
 }  // namespace
 
-void writeHeader(const Header& h, uint8_t* out) {
-  std::memset(out, 0, kHeaderBytes);
-  std::memcpy(out + kOffMagic, kMagic, 4);
+size_t writeHeader(const Header& h, uint8_t* out) {
+  std::memcpy(out, kMagic, 4);
   put16(out + kOffVersion, kFormatVersion);
-  put16(out + kOffHeaderBytes, uint16_t(kHeaderBytes));
-  out[kOffQuantization] = uint8_t(h.quantization);
-  out[kOffBits] = h.bits;
-  out[kOffMaxDimension] = h.maxDimension;
-  put32(out + kOffVertexCount, h.vertexCount);
-  for (size_t d = 0; d < 4; ++d) put32(out + kOffSimplexCounts + 4 * d, h.simplexCounts[d]);
-  for (size_t a = 0; a < 3; ++a) put32(out + kOffGridMax + 4 * a, h.gridMax[a]);
+  uint8_t* at = out + kHeaderPrefixBytes;
+  *at++ = uint8_t(uint8_t(h.quantization) | h.maxDimension << 2);
+  *at++ = h.bits;
+  at += putVarint(at, h.vertexCount);
+  for (const uint32_t count : h.simplexCounts) at += putVarint(at, count);
+  for (const uint32_t max : h.gridMax) at += putVarint(at, max);
+  at += putVarint(at, h.bodyBytes);
+  at += putVarint(at, h.chunkCount);
   if (h.quantization == Quantization::Grid) {
-    for (size_t a = 0; a < 3; ++a) putDouble(out + kOffQuantParams + 8 * a, h.origin[a]);
-    putDouble(out + kOffQuantParams + 24, h.step);
+    // The origin is a corner of the input's bounding box: floats.
+    for (const double origin : h.origin) putFloat32(at, float(origin));
+    putFloat64(at, h.step);
   } else {
-    for (size_t a = 0; a < 3; ++a) put32(out + kOffQuantParams + 4 * a, h.floatImageMin[a]);
+    for (const uint32_t image : h.floatImageMin) at += putVarint(at, image);
   }
-  put64(out + kOffBodyBytes, h.bodyBytes);
-  put32(out + kOffChunkCount, h.chunkCount);
-  put32(out + kOffChecksum, crc32(out, kOffChecksum));
+  const size_t size = size_t(at - out) + 4;
+  out[kOffHeaderBytes] = uint8_t(size);
+  put32(at, crc32(out, size - 4));
+  return size;
 }
 
-Status readHeader(const uint8_t* in, const DecoderLimits& limits, Header& h) {
-  if (std::memcmp(in + kOffMagic, kMagic, 4) != 0)
+Status headerSize(const uint8_t* in, size_t& size) {
+  if (std::memcmp(in, kMagic, 4) != 0)
     return Status::error(ErrorCode::BadMagic, "not a kdmesh stream (bad magic bytes)");
-  h = Header{};
-  h.version = get16(in + kOffVersion);
-  if (h.version != kFormatVersion)
+  const uint16_t version = get16(in + kOffVersion);
+  if (version != kFormatVersion)
     return Status::error(ErrorCode::UnsupportedVersion,
-                         "stream format version " + std::to_string(h.version) +
+                         "stream format version " + std::to_string(version) +
                              " is not supported (this decoder reads version " +
                              std::to_string(kFormatVersion) + ")");
-  if (get16(in + kOffHeaderBytes) != kHeaderBytes) return corrupt("unexpected header size");
-  if (crc32(in, kOffChecksum) != get32(in + kOffChecksum)) return corrupt("checksum mismatch");
-  if (in[kOffReserved] != 0 || get32(in + kOffFlags) != 0) return corrupt("unknown flags");
-  h.quantization = Quantization(in[kOffQuantization]);
-  h.bits = in[kOffBits];
-  h.maxDimension = in[kOffMaxDimension];
-  h.vertexCount = get32(in + kOffVertexCount);
-  for (size_t d = 0; d < 4; ++d) h.simplexCounts[d] = get32(in + kOffSimplexCounts + 4 * d);
-  for (size_t a = 0; a < 3; ++a) h.gridMax[a] = get32(in + kOffGridMax + 4 * a);
+  size = in[kOffHeaderBytes];
+  if (size < kHeaderPrefixBytes + 4 || size > kMaxHeaderBytes) return corrupt("bad header size");
+  return Status::success();
+}
+
+Status readHeader(const uint8_t* in, size_t size, const DecoderLimits& limits, Header& h) {
+  if (Status s = headerSize(in, size); !s.ok()) return s;
+  if (size != in[kOffHeaderBytes]) return corrupt("header size mismatch");
+  if (crc32(in, size - 4) != get32(in + size - 4)) return corrupt("checksum mismatch");
+  h = Header{};
+  h.version = kFormatVersion;
+  h.headerBytes = uint8_t(size);
+  const uint8_t* at = in + kHeaderPrefixBytes;
+  const uint8_t* const end = in + size - 4;
+  if (end - at < 2) return corrupt("truncated fields");
+  const uint8_t mode = *at++;
+  if (mode & kModeReserved) return corrupt("unknown flags");
+  h.quantization = Quantization(mode & 3);
+  h.maxDimension = uint8_t(mode >> 2 & 3);
+  h.bits = *at++;
+  bool ok = true;
+  auto u32 = [&](uint32_t& field) {
+    uint64_t v = 0;
+    ok = ok && getVarint(at, end, 5, 0xffffffffu, v);
+    field = uint32_t(v);
+  };
+  u32(h.vertexCount);
+  for (uint32_t& count : h.simplexCounts) u32(count);
+  for (uint32_t& max : h.gridMax) u32(max);
+  ok = ok && getVarint(at, end, 9, uint64_t(1) << 62, h.bodyBytes);
+  u32(h.chunkCount);
   if (h.quantization == Quantization::Grid) {
-    for (size_t a = 0; a < 3; ++a) h.origin[a] = getDouble(in + kOffQuantParams + 8 * a);
-    h.step = getDouble(in + kOffQuantParams + 24);
+    if (end - at < 20) return corrupt("truncated fields");
+    for (double& origin : h.origin) origin = getFloat32(at);
+    h.step = getFloat64(at);
   } else {
-    for (size_t a = 0; a < 3; ++a) h.floatImageMin[a] = get32(in + kOffQuantParams + 4 * a);
+    for (uint32_t& image : h.floatImageMin) u32(image);
   }
-  h.bodyBytes = get64(in + kOffBodyBytes);
-  h.chunkCount = get32(in + kOffChunkCount);
+  if (!ok || at != end) return corrupt("malformed fields");
   return validate(h, limits);
 }
 
@@ -169,14 +214,37 @@ std::array<uint64_t, 4> simplexCaps(const Header& h) {
   return {0, edges + 3 * triangles + 6 * tetrahedra, triangles + 4 * tetrahedra, tetrahedra};
 }
 
-void writeChunkFrame(const ChunkFrame& frame, uint8_t* out) {
-  put32(out, frame.payloadBytes);
-  put32(out + 4, frame.splitCount);
-  put32(out + 8, frame.checksum);
+size_t writeChunkFrame(const ChunkFrame& frame, uint8_t* out) {
+  const size_t n = putVarint(out, frame.payloadBytes);
+  return n + putVarint(out + n, frame.splitCount);
 }
 
-ChunkFrame readChunkFrame(const uint8_t* in) {
-  return {get32(in), get32(in + 4), get32(in + 8)};
+void writeChunkChecksum(const uint8_t* chunk, size_t checked, uint8_t* out) {
+  put32(out, crc32(chunk, checked));
+}
+
+bool chunkChecksumMatches(const uint8_t* chunk, size_t checked) {
+  return crc32(chunk, checked) == get32(chunk + checked);
+}
+
+FrameRead readChunkFrame(const uint8_t* in, size_t available, ChunkFrame& frame, size_t& size) {
+  const uint8_t* at = in;
+  const uint8_t* const end = in + available;
+  uint32_t* const fields[2] = {&frame.payloadBytes, &frame.splitCount};
+  for (uint32_t* field : fields) {
+    uint64_t value = 0;
+    for (int i = 0;; ++i) {
+      if (i == 5) return FrameRead::Malformed;
+      if (at == end) return FrameRead::Incomplete;
+      const uint8_t byte = *at++;
+      value |= uint64_t(byte & 0x7f) << (7 * i);
+      if (!(byte & 0x80)) break;
+    }
+    if (value > 0xffffffffu) return FrameRead::Malformed;
+    *field = uint32_t(value);
+  }
+  size = size_t(at - in);
+  return FrameRead::Complete;
 }
 
 }  // namespace kdmesh

@@ -1,5 +1,7 @@
-// The stream container: a fixed header followed by length-prefixed chunks.
-// See docs/FORMAT.md for the byte layout.
+// The stream container: a header followed by length-prefixed, checksummed
+// chunks. Counts and sizes are variable-length integers, so the container
+// costs a small model tens of bytes, not hundreds. See docs/FORMAT.md for
+// the byte layout.
 #pragma once
 
 #include <array>
@@ -10,26 +12,39 @@
 
 namespace kdmesh {
 
-constexpr uint16_t kFormatVersion = 8;
+constexpr uint16_t kFormatVersion = 9;
 
-void writeHeader(const Header& header, uint8_t* out /* kHeaderBytes */);
-// Parses and validates a header: magic, version, checksum and every field's
-// range. Limits are checked here so nothing is allocated for a hostile header.
-Status readHeader(const uint8_t* in /* kHeaderBytes */, const DecoderLimits& limits,
-                  Header& header);
+// Writes the header (its headerBytes field is ignored) and returns its size.
+size_t writeHeader(const Header& header, uint8_t* out /* kMaxHeaderBytes */);
+// The size of the header that starts with these bytes, after checking its
+// magic bytes and version.
+Status headerSize(const uint8_t* in /* kHeaderPrefixBytes */, size_t& size);
+// Parses and validates a header of `size` bytes: checksum, layout and every
+// field's range. Limits are checked here so nothing is allocated for a
+// hostile header.
+Status readHeader(const uint8_t* in, size_t size, const DecoderLimits& limits, Header& header);
 
 // Upper bounds on the simplices of each dimension 1..3 that the complex can
 // hold at any level (maximal ones and their faces): coarser levels never
 // have more simplices of a dimension than the complete complex.
 std::array<uint64_t, 4> simplexCaps(const Header& header);
 
+// A chunk is its frame (the two counts below), its payload, and a CRC-32 of
+// both.
 struct ChunkFrame {
   uint32_t payloadBytes = 0;
   uint32_t splitCount = 0;
-  uint32_t checksum = 0;
 };
+constexpr size_t kMaxChunkFrameBytes = 10;
+constexpr size_t kChunkChecksumBytes = 4;
 
-void writeChunkFrame(const ChunkFrame& frame, uint8_t* out /* kChunkFrameBytes */);
-ChunkFrame readChunkFrame(const uint8_t* in /* kChunkFrameBytes */);
+// Writes the frame and returns its size.
+size_t writeChunkFrame(const ChunkFrame& frame, uint8_t* out /* kMaxChunkFrameBytes */);
+// The checksum after a chunk's first `checked` bytes (frame and payload).
+void writeChunkChecksum(const uint8_t* chunk, size_t checked, uint8_t* out /* kChunkChecksumBytes */);
+bool chunkChecksumMatches(const uint8_t* chunk, size_t checked);
+enum class FrameRead { Complete, Incomplete, Malformed };
+// Reads the frame at the start of in[0..available); `size` gets its size.
+FrameRead readChunkFrame(const uint8_t* in, size_t available, ChunkFrame& frame, size_t& size);
 
 }  // namespace kdmesh

@@ -8,7 +8,6 @@
 
 #include "container.h"
 #include "count_coder.h"
-#include "crc32.h"
 #include "kdmesh/kdmesh.h"
 #include "position_predictor.h"
 #include "quantizer.h"
@@ -123,11 +122,12 @@ struct Decoder::State {
     return Status::success();
   }
 
-  Status applyChunk(const uint8_t* payload, const ChunkFrame& frame) {
+  // `chunk`: the whole chunk, frameBytes of frame first.
+  Status applyChunk(const uint8_t* chunk, size_t frameBytes, const ChunkFrame& frame) {
     const std::string where = "chunk " + std::to_string(chunks.size());
-    if (crc32(payload, frame.payloadBytes) != frame.checksum)
+    if (!chunkChecksumMatches(chunk, frameBytes + frame.payloadBytes))
       return Status::error(ErrorCode::CorruptChunk, where + ": checksum mismatch");
-    coder.start(payload, frame.payloadBytes);
+    coder.start(chunk + frameBytes, frame.payloadBytes);
     for (uint32_t left = frame.splitCount; left > 0;) {
       if (complete())
         return Status::error(ErrorCode::CorruptChunk,
@@ -345,11 +345,14 @@ struct Decoder::State {
       const size_t available = size - offset;
       const uint8_t* at = data + offset;
       if (!hasHeader) {
-        if (available < kHeaderBytes) break;
-        status = readHeader(at, options.limits, header);
+        if (available < kHeaderPrefixBytes) break;
+        size_t size = 0;
+        status = headerSize(at, size);
+        if (!status.ok() || available < size) break;
+        status = readHeader(at, size, options.limits, header);
         if (status.ok()) status = startBody(available);
-        offset += kHeaderBytes;
-        bytesConsumed += kHeaderBytes;
+        offset += size;
+        bytesConsumed += size;
         continue;
       }
       if (chunks.size() == header.chunkCount) {
@@ -358,20 +361,25 @@ struct Decoder::State {
                                  std::to_string(available) + " bytes after the end of the stream");
         break;
       }
-      if (available < kChunkFrameBytes) break;
-      const ChunkFrame frame = readChunkFrame(at);
-      const uint64_t end = bytesConsumed + kChunkFrameBytes + uint64_t(frame.payloadBytes);
-      if (frame.payloadBytes > options.limits.maxChunkBytes || end > header.totalBytes() ||
-          frame.splitCount == 0 || frame.splitCount > kMaxSplitsPerByte * (uint64_t(frame.payloadBytes) + 8)) {
+      ChunkFrame frame;
+      size_t frameBytes = 0;
+      const FrameRead read = readChunkFrame(at, available, frame, frameBytes);
+      if (read == FrameRead::Incomplete) break;
+      const uint64_t chunkBytes = frameBytes + uint64_t(frame.payloadBytes) + kChunkChecksumBytes;
+      const uint64_t end = bytesConsumed + chunkBytes;
+      if (read == FrameRead::Malformed || frame.payloadBytes > options.limits.maxChunkBytes ||
+          end > header.totalBytes() || frame.splitCount == 0 ||
+          frame.splitCount > kMaxSplitsPerByte * (uint64_t(frame.payloadBytes) + 8)) {
         status = Status::error(ErrorCode::CorruptChunk,
                                "chunk " + std::to_string(chunks.size()) + ": invalid frame");
         break;
       }
-      if (available < kChunkFrameBytes + frame.payloadBytes) break;
-      status = applyChunk(at + kChunkFrameBytes, frame);
+      if (available < chunkBytes) break;
+      status = applyChunk(at, frameBytes, frame);
       if (!status.ok()) break;
-      chunks.push_back({bytesConsumed, frame.payloadBytes, frame.splitCount});
-      offset += kChunkFrameBytes + frame.payloadBytes;
+      chunks.push_back({bytesConsumed, frame.payloadBytes, frame.splitCount,
+                        uint32_t(frameBytes + kChunkChecksumBytes)});
+      offset += size_t(chunkBytes);
       bytesConsumed = end;
       if (chunks.size() == header.chunkCount && !complete())
         status = Status::error(ErrorCode::CorruptChunk,

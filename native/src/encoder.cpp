@@ -6,7 +6,6 @@
 
 #include "container.h"
 #include "count_coder.h"
-#include "crc32.h"
 #include "decimation.h"
 #include "encoder_internal.h"
 #include "kd_order.h"
@@ -72,21 +71,24 @@ class ChunkWriter {
   }
 
  private:
+  // The payload is written after room for the longest frame; the frame,
+  // once known, goes right before it.
   void begin() {
     frameAt_ = body_.size();
-    body_.resize(frameAt_ + kChunkFrameBytes);
+    body_.resize(frameAt_ + kMaxChunkFrameBytes);
     coder_.restart();
     splits_ = 0;
   }
 
   void end() {
     coder_.finish();
-    const size_t payloadAt = frameAt_ + kChunkFrameBytes;
-    ChunkFrame frame;
-    frame.payloadBytes = uint32_t(body_.size() - payloadAt);
-    frame.splitCount = splits_;
-    frame.checksum = crc32(body_.data() + payloadAt, frame.payloadBytes);
-    writeChunkFrame(frame, body_.data() + frameAt_);
+    const size_t payloadAt = frameAt_ + kMaxChunkFrameBytes;
+    const ChunkFrame frame{uint32_t(body_.size() - payloadAt), splits_};
+    const size_t frameBytes = writeChunkFrame(frame, body_.data() + frameAt_);
+    body_.erase(body_.begin() + std::ptrdiff_t(frameAt_ + frameBytes), body_.begin() + std::ptrdiff_t(payloadAt));
+    const size_t checked = body_.size() - frameAt_;
+    body_.resize(body_.size() + kChunkChecksumBytes);
+    writeChunkChecksum(body_.data() + frameAt_, checked, body_.data() + frameAt_ + checked);
     ++chunks_;
     frameAt_ = body_.size();
   }
@@ -341,9 +343,10 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
   predictor.addStatistics(result.statistics);
   report("code", 1);
 
-  result.bytes.resize(kHeaderBytes + body.size());
-  writeHeader(header, result.bytes.data());
-  if (!body.empty()) std::memcpy(result.bytes.data() + kHeaderBytes, body.data(), body.size());
+  result.bytes.resize(kMaxHeaderBytes + body.size());
+  const size_t headerBytes = writeHeader(header, result.bytes.data());
+  result.bytes.resize(headerBytes);
+  result.bytes.insert(result.bytes.end(), body.begin(), body.end());
   return result;
 }
 

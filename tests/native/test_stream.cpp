@@ -2,10 +2,11 @@
 // any size give the same result, and damaged streams are refused.
 #include <gtest/gtest.h>
 
+#include <cfloat>
+#include <limits>
 #include <random>
 
 #include "container.h"
-#include "crc32.h"
 #include "shapes.h"
 #include "test_support.h"
 
@@ -24,7 +25,7 @@ std::vector<size_t> cutPoints(const Decoder& full, size_t total, size_t arbitrar
   std::vector<size_t> cuts;
   for (const ChunkInfo& c : full.chunks()) {
     cuts.push_back(c.offset);
-    cuts.push_back(c.offset + kChunkFrameBytes + c.payloadBytes);
+    cuts.push_back(c.offset + c.frameBytes + c.payloadBytes);
   }
   std::mt19937 rng(seed);
   for (size_t i = 0; i < arbitrary; ++i) cuts.push_back(rng() % (total + 1));
@@ -46,7 +47,7 @@ TEST(Stream, EveryPrefixDecodesToACoarserValidCloud) {
     SCOPED_TRACE("prefix of " + std::to_string(cut) + " bytes");
     Decoder d;
     ASSERT_TRUE(d.push(bytes.data(), cut).ok());
-    if (cut < kHeaderBytes) {
+    if (cut < h.headerBytes) {
       EXPECT_FALSE(d.hasHeader());
       continue;
     }
@@ -94,15 +95,20 @@ TEST(Stream, PushingInPiecesOfAnySizeMatchesDecodingThePrefixAtOnce) {
 
 TEST(Stream, ProgressReportsBytesLevelsAndChunks) {
   const std::vector<uint8_t> bytes = sphereStream(8000, 4096);
+  size_t headerBytes = 0;
+  ASSERT_TRUE(headerSize(bytes.data(), headerBytes).ok());
   Decoder d;
   EXPECT_EQ(d.progress().bytesExpected, 0u);
-  ASSERT_TRUE(d.push(bytes.data(), kHeaderBytes).ok());
+  ASSERT_TRUE(d.push(bytes.data(), headerBytes - 1).ok());
+  EXPECT_FALSE(d.hasHeader());
+  ASSERT_TRUE(d.push(bytes.data() + headerBytes - 1, 1).ok());
   EXPECT_TRUE(d.hasHeader());
   EXPECT_EQ(d.header().vertexCount, 8000u);
   EXPECT_EQ(d.progress().bytesExpected, bytes.size());
   EXPECT_EQ(d.progress().cellCount, 1u);
   EXPECT_EQ(d.snapshot().vertexCount(), 1u);
-  ASSERT_TRUE(d.push(bytes.data() + kHeaderBytes, bytes.size() - kHeaderBytes).ok());
+  EXPECT_EQ(d.header().headerBytes, headerBytes);
+  ASSERT_TRUE(d.push(bytes.data() + headerBytes, bytes.size() - headerBytes).ok());
   const DecodeProgress p = d.progress();
   EXPECT_TRUE(p.complete);
   EXPECT_EQ(p.bytesConsumed, bytes.size());
@@ -159,12 +165,11 @@ TEST(Stream, NoiseWithValidChecksumsNeverBreaksTheDecoder) {
   for (int trial = 0; trial < 200; ++trial) {
     std::vector<uint8_t> hostile = bytes;
     for (const ChunkInfo& c : reference.chunks()) {
-      uint8_t* payload = hostile.data() + c.offset + kChunkFrameBytes;
-      for (uint32_t i = 0; i < c.payloadBytes; ++i)
-        if (rng() % 4 == 0) payload[i] = uint8_t(rng());
-      ChunkFrame frame = readChunkFrame(hostile.data() + c.offset);
-      frame.checksum = crc32(payload, c.payloadBytes);
-      writeChunkFrame(frame, hostile.data() + c.offset);
+      uint8_t* chunk = hostile.data() + c.offset;
+      const size_t checked = c.frameBytes - kChunkChecksumBytes + c.payloadBytes;
+      for (size_t i = c.frameBytes - kChunkChecksumBytes; i < checked; ++i)
+        if (rng() % 4 == 0) chunk[i] = uint8_t(rng());
+      writeChunkChecksum(chunk, checked, chunk + checked);
     }
     Complex out;
     const Status s = decode(hostile.data(), hostile.size(), out);
@@ -179,55 +184,136 @@ TEST(Stream, NoiseWithValidChecksumsNeverBreaksTheDecoder) {
 Header validHeader() {
   const std::vector<uint8_t> bytes = sphereStream(100, 256);
   Header h;
-  EXPECT_TRUE(readHeader(bytes.data(), DecoderLimits{}, h).ok());
+  size_t size = 0;
+  EXPECT_TRUE(headerSize(bytes.data(), size).ok());
+  EXPECT_TRUE(readHeader(bytes.data(), size, DecoderLimits{}, h).ok());
   return h;
 }
 
 TEST(Stream, HostileHeadersAreRefusedBeforeAnyAllocation) {
-  uint8_t buffer[kHeaderBytes];
+  uint8_t buffer[kMaxHeaderBytes];
   Header h = validHeader();
   h.vertexCount = 2000000000u;
-  writeHeader(h, buffer);
+  size_t size = writeHeader(h, buffer);
   Decoder d;
-  EXPECT_EQ(d.push(buffer, sizeof buffer).code, ErrorCode::LimitExceeded);
+  EXPECT_EQ(d.push(buffer, size).code, ErrorCode::LimitExceeded);
   // The error sticks.
   EXPECT_EQ(d.push(buffer, 1).code, ErrorCode::LimitExceeded);
 
   h = validHeader();
   h.bits = 31;
-  writeHeader(h, buffer);
+  size = writeHeader(h, buffer);
   Decoder d2;
-  EXPECT_EQ(d2.push(buffer, sizeof buffer).code, ErrorCode::CorruptHeader);
+  EXPECT_EQ(d2.push(buffer, size).code, ErrorCode::CorruptHeader);
 
   h = validHeader();
   h.chunkCount = uint32_t(h.bodyBytes);  // more chunks than frames could fit
-  writeHeader(h, buffer);
+  size = writeHeader(h, buffer);
   Decoder d3;
-  EXPECT_EQ(d3.push(buffer, sizeof buffer).code, ErrorCode::CorruptHeader);
+  EXPECT_EQ(d3.push(buffer, size).code, ErrorCode::CorruptHeader);
 
-  const uint8_t text[kHeaderBytes] = "ply\nformat ascii 1.0\n";
+  const uint8_t text[] = "ply\nformat ascii 1.0\n";
   Decoder d4;
   EXPECT_EQ(d4.push(text, sizeof text).code, ErrorCode::BadMagic);
+
+  // A size byte that says the header is longer or shorter than its fields.
+  h = validHeader();
+  size = writeHeader(h, buffer);
+  for (const int change : {-1, 1, 80}) {
+    uint8_t resized[kMaxHeaderBytes + 1] = {};
+    std::copy(buffer, buffer + size, resized);
+    resized[kHeaderPrefixBytes - 1] = uint8_t(int(size) + change);
+    Decoder d5;
+    EXPECT_EQ(d5.push(resized, sizeof resized).code, ErrorCode::CorruptHeader) << change;
+  }
+}
+
+// Every field's largest value fits the header's largest size, and every
+// field reads back as written, in both quantization modes.
+TEST(Stream, HeadersRoundTripWithTheirLargestValues) {
+  DecoderLimits limits;
+  limits.maxVertices = 0xffffffffu;
+  limits.maxSimplices = 0xffffffffu;
+  for (const Quantization mode : {Quantization::Grid, Quantization::Float32}) {
+    Header h;
+    h.quantization = mode;
+    h.bits = mode == Quantization::Grid ? 30 : 32;
+    h.vertexCount = (1u << 31) - 1;
+    h.maxDimension = 3;
+    h.simplexCounts = {h.vertexCount, 1u << 30, 1u << 30, 1u << 30};
+    h.gridMax = {(1u << 30) - 1, 5, 0};
+    h.origin = {-double(FLT_MAX), double(std::numeric_limits<float>::denorm_min()), 0};
+    h.step = 1e300;
+    h.floatImageMin = {0x00800000u, 0x7f000000u, 0x80000000u};
+    h.bodyBytes = (uint64_t(1) << 62) - 1;
+    h.chunkCount = 0xffffffffu;
+    uint8_t buffer[kMaxHeaderBytes];
+    const size_t size = writeHeader(h, buffer);
+    ASSERT_LE(size, kMaxHeaderBytes);
+    Header back;
+    const Status read = readHeader(buffer, size, limits, back);
+    ASSERT_TRUE(read.ok()) << read.message;
+    EXPECT_EQ(back.headerBytes, size);
+    EXPECT_EQ(back.vertexCount, h.vertexCount);
+    EXPECT_EQ(back.simplexCounts, h.simplexCounts);
+    EXPECT_EQ(back.gridMax, h.gridMax);
+    EXPECT_EQ(back.bodyBytes, h.bodyBytes);
+    EXPECT_EQ(back.chunkCount, h.chunkCount);
+    if (mode == Quantization::Grid) {
+      EXPECT_EQ(back.origin, h.origin);
+      EXPECT_EQ(back.step, h.step);
+    } else {
+      EXPECT_EQ(back.floatImageMin, h.floatImageMin);
+    }
+  }
+}
+
+// The header, then a chunk frame of these counts and nothing more.
+std::vector<uint8_t> headerAndFrame(const std::vector<uint8_t>& stream, const ChunkFrame& frame) {
+  size_t size = 0;
+  EXPECT_TRUE(headerSize(stream.data(), size).ok());
+  std::vector<uint8_t> bytes(stream.begin(), stream.begin() + std::ptrdiff_t(size));
+  uint8_t framed[kMaxChunkFrameBytes];
+  bytes.insert(bytes.end(), framed, framed + writeChunkFrame(frame, framed));
+  return bytes;
 }
 
 TEST(Stream, ChunkFramesLargerThanTheLimitAreRefusedEarly) {
-  std::vector<uint8_t> bytes = sphereStream(100, 256);
-  ChunkFrame frame = readChunkFrame(bytes.data() + kHeaderBytes);
-  frame.payloadBytes = 0x7fffffff;
-  writeChunkFrame(frame, bytes.data() + kHeaderBytes);
+  const std::vector<uint8_t> bytes = headerAndFrame(sphereStream(100, 256), {0x7fffffff, 1});
   Decoder d;
-  EXPECT_EQ(d.push(bytes.data(), kHeaderBytes + kChunkFrameBytes).code, ErrorCode::CorruptChunk);
+  EXPECT_EQ(d.push(bytes.data(), bytes.size()).code, ErrorCode::CorruptChunk);
 }
 
-// The frame's split count is not under the payload checksum: a count that no
-// payload of that size can hold is refused before any work.
-TEST(Stream, ChunkFramesClaimingMoreSplitsThanTheirBytesCanCodeAreRefused) {
-  std::vector<uint8_t> bytes = sphereStream(100, 256);
-  ChunkFrame frame = readChunkFrame(bytes.data() + kHeaderBytes);
-  frame.splitCount = 0xffffffffu;
-  writeChunkFrame(frame, bytes.data() + kHeaderBytes);
+// Counts are varints of at most five bytes: a longer one, or one above
+// 2^32 - 1, is refused; one cut short waits for its next byte.
+TEST(Stream, MalformedChunkFramesAreRefusedAndPartialOnesWait) {
+  const std::vector<uint8_t> stream = sphereStream(100, 256);
+  size_t size = 0;
+  ASSERT_TRUE(headerSize(stream.data(), size).ok());
+  const std::vector<uint8_t> header(stream.begin(), stream.begin() + std::ptrdiff_t(size));
+  const std::vector<std::vector<uint8_t>> malformed = {{0x80, 0x80, 0x80, 0x80, 0x80, 0x01},
+                                                       {0xff, 0xff, 0xff, 0xff, 0x1f}};
+  for (const std::vector<uint8_t>& frame : malformed) {
+    std::vector<uint8_t> bytes = header;
+    bytes.insert(bytes.end(), frame.begin(), frame.end());
+    Decoder d;
+    EXPECT_EQ(d.push(bytes.data(), bytes.size()).code, ErrorCode::CorruptChunk);
+  }
+  std::vector<uint8_t> partial = header;
+  partial.insert(partial.end(), {0x80, 0x80});
   Decoder d;
-  EXPECT_EQ(d.push(bytes.data(), kHeaderBytes + kChunkFrameBytes).code, ErrorCode::CorruptChunk);
+  EXPECT_TRUE(d.push(partial.data(), partial.size()).ok());
+  EXPECT_EQ(d.progress().bytesConsumed, size);
+  EXPECT_EQ(d.finish().code, ErrorCode::Truncated);
+}
+
+// A frame is judged before the rest of its chunk (and the checksum at the
+// end) has arrived: a split count that no payload of that size can hold is
+// refused before any work.
+TEST(Stream, ChunkFramesClaimingMoreSplitsThanTheirBytesCanCodeAreRefused) {
+  const std::vector<uint8_t> bytes = headerAndFrame(sphereStream(100, 256), {20, 0xffffffffu});
+  Decoder d;
+  EXPECT_EQ(d.push(bytes.data(), bytes.size()).code, ErrorCode::CorruptChunk);
 }
 
 // Streams decode alike everywhere only if the encoder and every decoder

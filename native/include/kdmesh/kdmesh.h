@@ -87,10 +87,11 @@ enum class Quantization : uint8_t {
   Float32 = 1,  // every float32 coordinate bit-exact
 };
 
-// Everything a decoder knows once the fixed-size header has arrived.
+// Everything a decoder knows once the header has arrived.
 // The layout is specified in docs/FORMAT.md.
 struct Header {
   uint16_t version = 0;
+  uint8_t headerBytes = 0;          // the header's own size (it varies with its values)
   Quantization quantization = Quantization::Grid;
   uint8_t bits = 0;                 // grid bits of the longest axis (Grid)
   uint32_t vertexCount = 0;
@@ -113,10 +114,10 @@ struct Header {
   uint64_t totalBytes() const;
 };
 
-// Size in bytes of the fixed header that starts every stream.
-constexpr size_t kHeaderBytes = 96;
-// Size in bytes of the frame in front of every chunk's payload.
-constexpr size_t kChunkFrameBytes = 12;
+// The header that starts every stream is at most this long; its first
+// kHeaderPrefixBytes say how long it is.
+constexpr size_t kMaxHeaderBytes = 87;
+constexpr size_t kHeaderPrefixBytes = 7;
 
 // ---------------------------------------------------------------------------
 // Encoding
@@ -212,9 +213,10 @@ struct DecoderOptions {
 };
 
 struct ChunkInfo {
-  uint64_t offset;        // of the chunk frame, from the start of the stream
+  uint64_t offset;        // of the chunk, from the start of the stream
   uint32_t payloadBytes;
   uint32_t splitCount;    // kd-tree cells the chunk refines
+  uint32_t frameBytes;    // the chunk's bytes besides the payload: its frame and checksum
 };
 
 // Where a decoder stands in the stream.
