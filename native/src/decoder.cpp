@@ -187,7 +187,9 @@ struct Decoder::State {
         store.growVertices(std::min<uint32_t>(header.vertexCount, 2 * store.vertexCapacity()));
       parents.push_back(cell.vertex);
       const double before = coder.cost();
-      if (!splitter->split(coder, cell.vertex, added, level, [] { return uint8_t(0); })) return false;
+      if (!splitter->split(coder, cell.vertex, added, level, splitBalance(population, firstHalf, geometric),
+                           [] { return uint8_t(0); }))
+        return false;
       cost.connectivityBits += coder.cost() - before;
     }
     for (const uint32_t half : {firstHalf, population - firstHalf}) {

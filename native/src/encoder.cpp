@@ -293,7 +293,8 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
                     connectivity ? predictor.countContext(kept, level) : CountContext{});
       if (connectivity && added != kNoSimplex) {
         const double before = coder.cost();
-        splitter.split(coder, kept, added, level, RecordReader{&records.bytes[records.begin[splitIndex]]});
+        splitter.split(coder, kept, added, level, splitBalance(population, firstHalf, geometric),
+                       RecordReader{&records.bytes[records.begin[splitIndex]]});
         ++splitIndex;
         connectivityBits += coder.cost() - before;
       }
@@ -329,6 +330,7 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
     keep(ModelFamily::CellCountsByParallelogram, counts.parallelogramModels().data());
     keep(ModelFamily::EdgeCodes, splitter.edgeModels());
     keep(ModelFamily::EdgeCodesByDirection, splitter.edgeDirectionModels());
+    keep(ModelFamily::EdgeCodesByBalance, splitter.edgeBalanceModels());
     keep(ModelFamily::TriangleCodes, splitter.triangleModels());
     auto keepMixer = [&](MixerFamily family, const auto& mixer) {
       std::vector<int32_t>& weights = finalModels->mixerWeights[int(family)];

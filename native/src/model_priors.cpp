@@ -8,8 +8,9 @@ namespace {
 // kOneVertexSplitPriors, kEdgeCodePriors, kCellCountPriors,
 // kOneVertexByPlanePriors, kOneVertexByCentroidPriors,
 // kEdgeCodeByDirectionPriors, kTriangleCodePriors,
-// kOneVertexByParallelogramPriors, kCellCountByParallelogramPriors: P(bit == 0) in units of
-// 2^-15, one per model, run-length coded (model_priors.h);
+// kOneVertexByParallelogramPriors, kCellCountByParallelogramPriors,
+// kEdgeCodeByBalancePriors: P(bit == 0) in units of 2^-15, one per model,
+// run-length coded (model_priors.h);
 // kOneVertexMixerPriors, kCellCountMixerPriors: starting mixer weights.
 #include "model_priors.inc"
 
@@ -39,6 +40,7 @@ static_assert(expandedSize(kEdgeCodeByDirectionPriors) == kFamilySize[5]);
 static_assert(expandedSize(kTriangleCodePriors) == kFamilySize[6]);
 static_assert(expandedSize(kOneVertexByParallelogramPriors) == kFamilySize[7]);
 static_assert(expandedSize(kCellCountByParallelogramPriors) == kFamilySize[8]);
+static_assert(expandedSize(kEdgeCodeByBalancePriors) == kFamilySize[9]);
 
 struct CodedFamily {
   const uint16_t* values;
@@ -61,7 +63,7 @@ void primeModels(ModelFamily family, BitModel* models) {
       codedFamily(kCellCountPriors),           codedFamily(kOneVertexByPlanePriors),
       codedFamily(kOneVertexByCentroidPriors), codedFamily(kEdgeCodeByDirectionPriors),
       codedFamily(kTriangleCodePriors),        codedFamily(kOneVertexByParallelogramPriors),
-      codedFamily(kCellCountByParallelogramPriors)};
+      codedFamily(kCellCountByParallelogramPriors), codedFamily(kEdgeCodeByBalancePriors)};
   const CodedFamily& coded = kPriors[int(family)];
   auto prime = [&models](uint16_t prior) {
     models->fast = models->slow = prior;

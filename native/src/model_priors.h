@@ -29,9 +29,10 @@ enum class ModelFamily {
   TriangleCodes,
   OneVertexByParallelogram,
   CellCountsByParallelogram,
+  EdgeCodesByBalance,
 };
-constexpr int kModelFamilies = 9;
-constexpr std::array<size_t, kModelFamilies> kFamilySize = {9000, 11760, 3042, 300, 250, 294, 864, 648, 768};
+constexpr int kModelFamilies = 10;
+constexpr std::array<size_t, kModelFamilies> kFamilySize = {9000, 11760, 3042, 300, 250, 294, 864, 648, 768, 2646};
 
 // model_priors.inc holds each family run-length coded: half the models of
 // the large families were never used in training and start at 1/2; a run of

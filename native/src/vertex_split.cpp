@@ -59,6 +59,15 @@ void sortByOthers(std::vector<StarEntry>& star, size_t first, size_t last, int d
 
 }  // namespace
 
+int splitBalance(uint32_t population, uint32_t first, bool geometric) {
+  if (!geometric) return 0;
+  const uint32_t second = population - first;
+  if (population == 2) return 1;
+  if (first <= 2 || second <= 2) return first == 1 ? 2 : second == 1 ? 3 : first == 2 ? 4 : 5;
+  const double share = double(first) / double(population);
+  return share < 0.35 ? 6 : share <= 0.65 ? 7 : 8;
+}
+
 void gatherStar(SimplexStore& store, uint32_t v, std::vector<StarEntry>& star,
                 std::array<size_t, 5>& begin) {
   star.clear();

@@ -60,6 +60,12 @@ constexpr uint8_t kParity0 = 2, kParity1 = 3;
 inline uint8_t target(int parity) { return uint8_t(kParity0 + parity); }
 }  // namespace split_record
 
+// How a cell's vertices divide between the halves of its split, `first` of
+// `population` in the lower half: a class of the star's edge codes (a half
+// of one or two vertices takes few of the edges, a large half many).
+// Class 0 for the splits of coincident vertices past the geometric levels.
+int splitBalance(uint32_t population, uint32_t first, bool geometric);
+
 // An entry of a vertex star in canonical order: by dimension, then by the
 // ascending ids of the simplex's other vertices. Entry 0 is the vertex.
 struct StarEntry {
@@ -99,20 +105,24 @@ class VertexSplitter {
     static_assert(sizeof(edgeDirectionModels_) / sizeof(BitModel) ==
                   kFamilySize[int(ModelFamily::EdgeCodesByDirection)]);
     primeModels(ModelFamily::EdgeCodesByDirection, edgeDirectionModels());
+    static_assert(sizeof(edgeBalanceModels_) / sizeof(BitModel) == kFamilySize[int(ModelFamily::EdgeCodesByBalance)]);
+    primeModels(ModelFamily::EdgeCodesByBalance, edgeBalanceModels());
     static_assert(sizeof(triangleModels_[0]) / sizeof(BitModel) == kFamilySize[int(ModelFamily::TriangleCodes)]);
     for (auto& models : triangleModels_) primeModels(ModelFamily::TriangleCodes, &models[0][0][0]);
   }
 
-  // Splits `v`, whose cell is at `level`, into `v` and `v2`. `next()` of the
-  // oracle gives the record byte of each star entry in canonical order.
+  // Splits `v`, whose cell is at `level`, into `v` and `v2`; `balance`:
+  // splitBalance() of the cell's split. `next()` of the oracle gives the
+  // record byte of each star entry in canonical order.
   // Returns false when the codes contradict each other or the store is full:
   // corrupt data on the decoder.
   template <class Coder, class Oracle>
-  bool split(Coder& coder, uint32_t v, uint32_t v2, int level, Oracle&& oracle);
+  bool split(Coder& coder, uint32_t v, uint32_t v2, int level, int balance, Oracle&& oracle);
 
   const ConnectivityStatistics& statistics() const { return statistics_; }
   BitModel* edgeModels() { return &edgeModels_[0][0][0][0][0]; }
   BitModel* edgeDirectionModels() { return &edgeDirectionModels_[0][0][0]; }
+  BitModel* edgeBalanceModels() { return &edgeBalanceModels_[0][0][0][0]; }
   BitModel* triangleModels() { return &triangleModels_[0][0][0][0]; }
 
  private:
@@ -140,7 +150,7 @@ class VertexSplitter {
   int triangleClass(const Entry& triangle) const;
   template <class Coder>
   uint8_t codeSymbol(Coder& coder, BitModel (&models)[3], uint8_t possible, uint8_t code,
-                     BitModel* mixedWith = nullptr, int mixerSet = 0);
+                     BitModel* mixedWith = nullptr, BitModel* mixedThird = nullptr, int mixerSet = 0);
   template <class Coder>
   void decideOrientation(Coder& coder, int dimension, uint32_t simplex, bool isCopy, uint8_t target);
   int predictFlip(int dimension, uint32_t simplex, int& voteClass);
@@ -184,23 +194,30 @@ class VertexSplitter {
   // Edges by direction class alone, mixed with the above (weights per cut
   // state but the last two share one).
   BitModel edgeDirectionModels_[kEdgeClasses][2][3];
-  Mixer<2> edgeMixer_{4, {45875, 19661}};
+  // Edges of surface stars by splitBalance() and direction class (bunny
+  // −0.048 bits per vertex, fandisk −0.046, triceratops −0.042), mixed in
+  // third; a tetrahedral star mixes a model that stays at 1/2 instead,
+  // which leaves its mix as it was (the ball lost 0.014 by the balance).
+  static constexpr int kBalanceClasses = 9;
+  BitModel edgeBalanceModels_[kBalanceClasses][kEdgeClasses][2][3];
+  BitModel neutral_[3];
+  Mixer<3> edgeMixer_{4, {45875, 19661, 16384}};
   // Orientation models: [dimension - 2][copy or new][vote class][face of higher].
   BitModel orientationModels_[2][2][3][2];
   ConnectivityStatistics statistics_;
 };
 
-// `mixedWith`: a second row of models, mixed with the first.
+// `mixedWith`, `mixedThird`: two more rows of models, mixed with the first.
 template <class Coder>
 uint8_t VertexSplitter::codeSymbol(Coder& coder, BitModel (&models)[3], uint8_t possible, uint8_t code,
-                                   BitModel* mixedWith, int mixerSet) {
+                                   BitModel* mixedWith, BitModel* mixedThird, int mixerSet) {
   int step = 0;
   for (uint8_t c = 1; c <= 4; ++c) {
     if (!(possible & (1u << (c - 1)))) continue;
     if ((possible >> c) == 0) return c;  // the last candidate left
     bool bit = c == code;
     if (mixedWith) {
-      bit = edgeMixer_.code(coder, mixerSet, {&models[step], &mixedWith[step]}, bit);
+      bit = edgeMixer_.code(coder, mixerSet, {&models[step], &mixedWith[step], &mixedThird[step]}, bit);
     } else {
       bit = coder.bit(models[step], bit);
     }
@@ -230,7 +247,7 @@ void VertexSplitter::decideOrientation(Coder& coder, int dimension, uint32_t sim
 }
 
 template <class Coder, class Oracle>
-bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, Oracle&& oracle) {
+bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int balance, Oracle&& oracle) {
   gatherStar(store_, v, star_, begin_);
   linkFans();
   classifyEdges(v, level);
@@ -265,10 +282,12 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, Ora
       // two sides share statistics (tetrahedral ball: −0.08 bits per
       // vertex; surfaces lose by it, their split is not symmetric enough).
       const bool mirrored = volume && geometric && cosines_[index - begin_[1]] > 0;
+      if (volume) std::fill(neutral_, neutral_ + 3, BitModel{});
       entry.code = mirrorCode(
           codeSymbol(coder, edgeModels_[cutState][mirrorSet(entry.fanCodes, mirrored)][entry.geometry][all],
                      mirrorSet(possible, mirrored), mirrorCode(code, mirrored),
-                     edgeDirectionModels_[entry.geometry][all], std::min(cutState, 3)),
+                     edgeDirectionModels_[entry.geometry][all],
+                     volume ? neutral_ : edgeBalanceModels_[balance][entry.geometry][all], std::min(cutState, 3)),
           mirrored);
       cutEdges += entry.code == 4;
       const uint8_t bit = uint8_t(1u << std::min(entry.code - 1, 2));

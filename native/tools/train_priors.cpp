@@ -31,7 +31,8 @@ constexpr const char* kNames[kFamilies] = {"kOneVertexSplitPriors", "kEdgeCodePr
                                            "kCellCountPriors", "kOneVertexByPlanePriors",
                                            "kOneVertexByCentroidPriors", "kEdgeCodeByDirectionPriors",
                                            "kTriangleCodePriors", "kOneVertexByParallelogramPriors",
-                                           "kCellCountByParallelogramPriors", "kOneVertexMixerPriors",
+                                           "kCellCountByParallelogramPriors", "kEdgeCodeByBalancePriors",
+                                           "kOneVertexMixerPriors",
                                            "kCellCountMixerPriors"};
 
 }  // namespace
