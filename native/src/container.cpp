@@ -39,16 +39,17 @@ size_t putVarint(uint8_t* p, uint64_t v) {
   return n;
 }
 
-// Reads a varint of at most `maxBytes` bytes from [at, end); false if it
-// runs past `end`, is longer, or exceeds `limit`.
-bool getVarint(const uint8_t*& at, const uint8_t* end, size_t maxBytes, uint64_t limit, uint64_t& v) {
+// Reads a varint of at most `maxBytes` bytes from [at, end): Incomplete if
+// `end` comes first, Malformed if it is longer or above `limit`.
+Parsed readVarint(const uint8_t*& at, const uint8_t* end, size_t maxBytes, uint64_t limit, uint64_t& v) {
   v = 0;
-  for (size_t i = 0; i < maxBytes && at < end; ++i) {
+  for (size_t i = 0; i < maxBytes; ++i) {
+    if (at == end) return Parsed::Incomplete;
     const uint8_t byte = *at++;
     v |= uint64_t(byte & 0x7f) << (7 * i);
-    if (!(byte & 0x80)) return v <= limit;
+    if (!(byte & 0x80)) return v <= limit ? Parsed::Complete : Parsed::Malformed;
   }
-  return false;
+  return Parsed::Malformed;
 }
 
 // IEEE-754 values as the little-endian bytes of their bit patterns.
@@ -189,13 +190,13 @@ Status readHeader(const uint8_t* in, size_t size, const DecoderLimits& limits, H
   bool ok = true;
   auto u32 = [&](uint32_t& field) {
     uint64_t v = 0;
-    ok = ok && getVarint(at, end, 5, 0xffffffffu, v);
+    ok = ok && readVarint(at, end, 5, 0xffffffffu, v) == Parsed::Complete;
     field = uint32_t(v);
   };
   u32(h.vertexCount);
   for (uint32_t& count : h.simplexCounts) u32(count);
   for (uint32_t& max : h.gridMax) u32(max);
-  ok = ok && getVarint(at, end, 9, uint64_t(1) << 62, h.bodyBytes);
+  ok = ok && readVarint(at, end, 9, uint64_t(1) << 62, h.bodyBytes) == Parsed::Complete;
   u32(h.chunkCount);
   if (h.quantization == Quantization::Grid) {
     if (end - at < 20) return corrupt("truncated fields");
@@ -227,24 +228,17 @@ bool chunkChecksumMatches(const uint8_t* chunk, size_t checked) {
   return crc32(chunk, checked) == get32(chunk + checked);
 }
 
-FrameRead readChunkFrame(const uint8_t* in, size_t available, ChunkFrame& frame, size_t& size) {
+Parsed readChunkFrame(const uint8_t* in, size_t available, ChunkFrame& frame, size_t& size) {
   const uint8_t* at = in;
-  const uint8_t* const end = in + available;
   uint32_t* const fields[2] = {&frame.payloadBytes, &frame.splitCount};
   for (uint32_t* field : fields) {
     uint64_t value = 0;
-    for (int i = 0;; ++i) {
-      if (i == 5) return FrameRead::Malformed;
-      if (at == end) return FrameRead::Incomplete;
-      const uint8_t byte = *at++;
-      value |= uint64_t(byte & 0x7f) << (7 * i);
-      if (!(byte & 0x80)) break;
-    }
-    if (value > 0xffffffffu) return FrameRead::Malformed;
+    if (const Parsed parsed = readVarint(at, in + available, 5, 0xffffffffu, value); parsed != Parsed::Complete)
+      return parsed;
     *field = uint32_t(value);
   }
   size = size_t(at - in);
-  return FrameRead::Complete;
+  return Parsed::Complete;
 }
 
 }  // namespace kdmesh

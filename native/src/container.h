@@ -43,8 +43,9 @@ size_t writeChunkFrame(const ChunkFrame& frame, uint8_t* out /* kMaxChunkFrameBy
 // The checksum after a chunk's first `checked` bytes (frame and payload).
 void writeChunkChecksum(const uint8_t* chunk, size_t checked, uint8_t* out /* kChunkChecksumBytes */);
 bool chunkChecksumMatches(const uint8_t* chunk, size_t checked);
-enum class FrameRead { Complete, Incomplete, Malformed };
+// What a read of bytes that may not all have arrived found.
+enum class Parsed { Complete, Incomplete, Malformed };
 // Reads the frame at the start of in[0..available); `size` gets its size.
-FrameRead readChunkFrame(const uint8_t* in, size_t available, ChunkFrame& frame, size_t& size);
+Parsed readChunkFrame(const uint8_t* in, size_t available, ChunkFrame& frame, size_t& size);
 
 }  // namespace kdmesh

@@ -365,11 +365,11 @@ struct Decoder::State {
       }
       ChunkFrame frame;
       size_t frameBytes = 0;
-      const FrameRead read = readChunkFrame(at, available, frame, frameBytes);
-      if (read == FrameRead::Incomplete) break;
+      const Parsed read = readChunkFrame(at, available, frame, frameBytes);
+      if (read == Parsed::Incomplete) break;
       const uint64_t chunkBytes = frameBytes + uint64_t(frame.payloadBytes) + kChunkChecksumBytes;
       const uint64_t end = bytesConsumed + chunkBytes;
-      if (read == FrameRead::Malformed || frame.payloadBytes > options.limits.maxChunkBytes ||
+      if (read == Parsed::Malformed || frame.payloadBytes > options.limits.maxChunkBytes ||
           end > header.totalBytes() || frame.splitCount == 0 ||
           frame.splitCount > kMaxSplitsPerByte * (uint64_t(frame.payloadBytes) + 8)) {
         status = Status::error(ErrorCode::CorruptChunk,
