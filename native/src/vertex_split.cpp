@@ -64,8 +64,9 @@ int splitBalance(uint32_t population, uint32_t first, bool geometric) {
   const uint32_t second = population - first;
   if (population == 2) return 1;
   if (first <= 2 || second <= 2) return first == 1 ? 2 : second == 1 ? 3 : first == 2 ? 4 : 5;
-  const double share = double(first) / double(population);
-  return share < 0.35 ? 6 : share <= 0.65 ? 7 : 8;
+  // The lower half's share below 0.35, up to 0.65 or above, compared exactly.
+  const uint64_t scaledFirst = uint64_t(first) * 20, scaledPopulation = population;
+  return scaledFirst < 7 * scaledPopulation ? 6 : scaledFirst <= 13 * scaledPopulation ? 7 : 8;
 }
 
 void gatherStar(SimplexStore& store, uint32_t v, std::vector<StarEntry>& star,
