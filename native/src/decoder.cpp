@@ -348,13 +348,13 @@ struct Decoder::State {
       const uint8_t* at = data + offset;
       if (!hasHeader) {
         if (available < kHeaderPrefixBytes) break;
-        size_t size = 0;
-        status = headerSize(at, size);
-        if (!status.ok() || available < size) break;
-        status = readHeader(at, size, options.limits, header);
+        size_t headerBytes = 0;
+        status = headerSize(at, headerBytes);
+        if (!status.ok() || available < headerBytes) break;
+        status = readHeader(at, headerBytes, options.limits, header);
         if (status.ok()) status = startBody(available);
-        offset += size;
-        bytesConsumed += size;
+        offset += headerBytes;
+        bytesConsumed += headerBytes;
         continue;
       }
       if (chunks.size() == header.chunkCount) {

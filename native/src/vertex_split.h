@@ -194,10 +194,12 @@ class VertexSplitter {
   // Edges by direction class alone, mixed with the above (weights per cut
   // state but the last two share one).
   BitModel edgeDirectionModels_[kEdgeClasses][2][3];
-  // Edges of surface stars by splitBalance() and direction class (bunny
-  // −0.048 bits per vertex, fandisk −0.046, triceratops −0.042), mixed in
-  // third; a tetrahedral star mixes a model that stays at 1/2 instead,
-  // which leaves its mix as it was (the ball lost 0.014 by the balance).
+  // Edges of surface stars by splitBalance() and direction class, mixed in
+  // third (with learned priors: dragon −0.114 bits per vertex, bunny
+  // −0.051, fandisk −0.065, triceratops −0.070); a tetrahedral star mixes a
+  // model reset to 1/2 at every edge instead, whose stretch of 0 leaves its
+  // mix and weights as a two-input mix would (the ball lost 0.014 by the
+  // balance).
   static constexpr int kBalanceClasses = 9;
   BitModel edgeBalanceModels_[kBalanceClasses][kEdgeClasses][2][3];
   BitModel neutral_[3];
