@@ -3,20 +3,12 @@
 #include <algorithm>
 
 namespace kdmesh {
-namespace {
-
-void sortSmall(uint32_t* v, int n) {
-  for (int i = 1; i < n; ++i)
-    for (int j = i; j > 0 && v[j - 1] > v[j]; --j) std::swap(v[j - 1], v[j]);
-}
-
-}  // namespace
 
 void SimplexStore::reset(uint32_t vertexCapacity, bool indexed) {
   indexed_ = indexed;
   for (int d = 1; d <= kMaxDimension; ++d) {
     pool_[d] = Pool{};
-    if (indexed) pool_[d].table.assign(16, kNoSimplex);
+    if (indexed) pool_[d].table.assign(16, IndexSlot{});
     heads_[d].assign(vertexCapacity, kNoSimplex);
     live_[d] = 0;
   }
@@ -36,61 +28,49 @@ void SimplexStore::setCapacity(int dimension, uint32_t maxSimplices, uint32_t ex
   pool.flags.reserve(expected);
 }
 
-uint64_t SimplexStore::hashOf(int dimension, const uint32_t* vertices) {
-  uint32_t v[4];
-  std::copy(vertices, vertices + dimension + 1, v);
-  sortSmall(v, dimension + 1);
-  uint64_t h = 0x9e3779b97f4a7c15ull * uint64_t(dimension + 1);
+// Order-independent: the sum of the vertices' mixed ids, so no sort.
+uint32_t SimplexStore::hashOf(int dimension, const uint32_t* vertices) {
+  uint64_t sum = uint64_t(dimension) << 56;
   for (int i = 0; i <= dimension; ++i) {
-    h ^= v[i];
-    h *= 0xff51afd7ed558ccdull;
-    h ^= h >> 32;
+    uint64_t h = (vertices[i] + 0x9e3779b97f4a7c15ull) * 0xff51afd7ed558ccdull;
+    sum += h ^ h >> 29;
   }
-  return h;
+  sum *= 0xc4ceb9fe1a85ec53ull;
+  return uint32_t(sum >> 32);
 }
 
+// Each of the simplex's vertices among `vertices` (both hold distinct ids),
+// without a branch per comparison.
 bool SimplexStore::sameSet(int dimension, uint32_t simplex, const uint32_t* vertices) const {
   const uint32_t* mine = this->vertices(dimension, simplex);
+  int found = 0;
   for (int i = 0; i <= dimension; ++i)
-    if (std::find(mine, mine + dimension + 1, vertices[i]) == mine + dimension + 1) return false;
-  return true;
+    for (int j = 0; j <= dimension; ++j) found += mine[i] == vertices[j];
+  return found == dimension + 1;
 }
 
-void SimplexStore::grow(int dimension) {
+// Sized for three times the live simplices at least, a table takes half as
+// many insertions again before it is half full: the rebuilds' work sums to
+// a few times the largest live count.
+void SimplexStore::rebuildIndex(int dimension) {
   Pool& pool = pool_[dimension];
-  std::vector<uint32_t> old(pool.table.size() * 2, kNoSimplex);
-  old.swap(pool.table);
-  for (const uint32_t simplex : old)
-    if (simplex != kNoSimplex) insertIndex(dimension, simplex);
+  size_t slots = 16;
+  while (slots < size_t(live_[dimension]) * 3 + 4) slots *= 2;
+  pool.table.assign(slots, IndexSlot{});
+  pool.tableEntries = 0;
+  for (uint32_t simplex = 0; simplex < size(dimension); ++simplex)
+    if (pool.flags[simplex] & kAlive) insertIndex(dimension, simplex);
 }
 
 void SimplexStore::insertIndex(int dimension, uint32_t simplex) {
   Pool& pool = pool_[dimension];
+  if (size_t(pool.tableEntries + 1) * 2 > pool.table.size()) return rebuildIndex(dimension);
+  const uint32_t hash = hashOf(dimension, vertices(dimension, simplex));
   const size_t mask = pool.table.size() - 1;
-  size_t at = size_t(hashOf(dimension, vertices(dimension, simplex))) & mask;
-  while (pool.table[at] != kNoSimplex) at = (at + 1) & mask;
-  pool.table[at] = simplex;
-}
-
-// Linear probing with backward-shift deletion: no tombstones, so lookups stay
-// short however many simplices the decimation kills.
-void SimplexStore::eraseIndex(int dimension, uint32_t simplex) {
-  Pool& pool = pool_[dimension];
-  const size_t mask = pool.table.size() - 1;
-  size_t at = size_t(hashOf(dimension, vertices(dimension, simplex))) & mask;
-  while (pool.table[at] != simplex) at = (at + 1) & mask;
-  for (size_t next = (at + 1) & mask;; next = (next + 1) & mask) {
-    const uint32_t moving = pool.table[next];
-    if (moving == kNoSimplex) break;
-    const size_t home = size_t(hashOf(dimension, vertices(dimension, moving))) & mask;
-    // `moving` may fill the hole unless its home lies cyclically in (at, next].
-    const bool homeInRange = at <= next ? (home > at && home <= next) : (home > at || home <= next);
-    if (!homeInRange) {
-      pool.table[at] = moving;
-      at = next;
-    }
-  }
-  pool.table[at] = kNoSimplex;
+  size_t at = hash & mask;
+  while (pool.table[at].simplex != kNoSimplex) at = (at + 1) & mask;
+  pool.table[at] = {simplex, hash};
+  ++pool.tableEntries;
 }
 
 uint32_t SimplexStore::add(int dimension, const uint32_t* vertices, uint8_t flags) {
@@ -102,10 +82,7 @@ uint32_t SimplexStore::add(int dimension, const uint32_t* vertices, uint8_t flag
   pool.vertices.insert(pool.vertices.end(), vertices, vertices + arity);
   pool.flags.push_back(uint8_t(flags | kAlive));
   ++live_[dimension];
-  if (indexed_) {
-    if (size_t(live_[dimension]) * 2 > pool.table.size()) grow(dimension);
-    insertIndex(dimension, simplex);
-  }
+  if (indexed_) insertIndex(dimension, simplex);
   // Slots pushed one by one: resize() was an out-of-line call in the
   // decoder's third most frequent function.
   for (uint32_t i = 0; i < arity; ++i) {
@@ -118,21 +95,21 @@ uint32_t SimplexStore::add(int dimension, const uint32_t* vertices, uint8_t flag
 uint32_t SimplexStore::find(int dimension, const uint32_t* vertices) const {
   const Pool& pool = pool_[dimension];
   const size_t mask = pool.table.size() - 1;
-  for (size_t at = size_t(hashOf(dimension, vertices)) & mask;; at = (at + 1) & mask) {
-    const uint32_t simplex = pool.table[at];
-    if (simplex == kNoSimplex) return kNoSimplex;
-    if (sameSet(dimension, simplex, vertices)) return simplex;
+  const uint32_t hash = hashOf(dimension, vertices);
+  for (size_t at = hash & mask;; at = (at + 1) & mask) {
+    const IndexSlot& entry = pool.table[at];
+    if (entry.simplex == kNoSimplex) return kNoSimplex;
+    if (entry.hash == hash && (pool.flags[entry.simplex] & kAlive) && sameSet(dimension, entry.simplex, vertices))
+      return entry.simplex;
   }
 }
 
 void SimplexStore::kill(int dimension, uint32_t simplex) {
-  if (indexed_) eraseIndex(dimension, simplex);
   pool_[dimension].flags[simplex] &= uint8_t(~kAlive);
   --live_[dimension];
 }
 
 void SimplexStore::replaceVertex(int dimension, uint32_t simplex, uint32_t from, uint32_t to) {
-  if (indexed_) eraseIndex(dimension, simplex);
   uint32_t* v = &pool_[dimension].vertices[size_t(simplex) * size_t(dimension + 1)];
   for (int i = 0; i <= dimension; ++i) v[i] = v[i] == from ? to : v[i];  // no branch to mispredict
   if (indexed_) insertIndex(dimension, simplex);
