@@ -88,11 +88,11 @@ double middleOf(const double* sorted, uint32_t count) {
   return count % 2 == 1 ? sorted[half] : 0.5 * (sorted[half - 1] + sorted[half]);
 }
 
-// Sorts eight values by a network of comparisons, each a min and a max: no
-// branch on the data, which falls either way at random. Unrolled, the values
-// stay in registers.
+// Applies a network of comparisons to eight values, each a min and a max:
+// no branch on the data, which falls either way at random. Unrolled, the
+// values stay in registers.
 template <size_t kComparisons>
-void sortEight(double (&v)[8], const uint8_t (&pairs)[kComparisons][2]) {
+void sortNetwork(double (&v)[8], const uint8_t (&pairs)[kComparisons][2]) {
 #pragma GCC unroll 19
   for (const auto& pair : pairs) {
     const double low = std::min(v[pair[0]], v[pair[1]]), high = std::max(v[pair[0]], v[pair[1]]);
@@ -104,6 +104,9 @@ void sortEight(double (&v)[8], const uint8_t (&pairs)[kComparisons][2]) {
 constexpr uint8_t kSortEight[19][2] = {{0, 2}, {1, 3}, {4, 6}, {5, 7}, {0, 4}, {1, 5}, {2, 6},
                                        {3, 7}, {0, 1}, {2, 3}, {4, 5}, {6, 7}, {2, 4}, {3, 5},
                                        {1, 4}, {3, 6}, {1, 2}, {3, 4}, {5, 6}};
+// Any six values in the first six places (12 comparisons, the fewest).
+constexpr uint8_t kSortSix[12][2] = {{0, 5}, {1, 3}, {2, 4}, {1, 2}, {3, 4}, {0, 3},
+                                     {2, 5}, {0, 1}, {2, 3}, {4, 5}, {1, 2}, {3, 4}};
 // Eight values that fall and then rise (Batcher's bitonic merge).
 constexpr uint8_t kMergeValley[12][2] = {{0, 4}, {1, 5}, {2, 6}, {3, 7}, {0, 2}, {1, 3},
                                          {4, 6}, {5, 7}, {0, 1}, {2, 3}, {4, 5}, {6, 7}};
@@ -113,14 +116,19 @@ constexpr uint8_t kMergeValley[12][2] = {{0, 4}, {1, 5}, {2, 6}, {3, 7}, {0, 2},
 void medianAndDeviation(double* values, uint32_t count, double& median, double& deviation) {
   if (count <= 8) {
     // Most vertices of a surface have at most eight triangles: sorted as
-    // eight, the rest infinite.
+    // eight, the rest infinite (and so are their deviations from a finite
+    // median). Six or fewer, the commonest, need only the first six sorted.
     double sorted[8];
     for (uint32_t i = 0; i < 8; ++i) sorted[i] = i < count ? values[i] : HUGE_VAL;
-    sortEight(sorted, kSortEight);
+    if (count <= 6) {
+      sortNetwork(sorted, kSortSix);
+    } else {
+      sortNetwork(sorted, kSortEight);
+    }
     median = middleOf(sorted, count);
     // The deviations of sorted values fall to the median and rise after it.
-    for (uint32_t i = 0; i < 8; ++i) sorted[i] = i < count ? std::fabs(sorted[i] - median) : HUGE_VAL;
-    sortEight(sorted, kMergeValley);
+    for (double& value : sorted) value = std::fabs(value - median);
+    sortNetwork(sorted, kMergeValley);
     deviation = middleOf(sorted, count);
     return;
   }
