@@ -338,7 +338,9 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
       for (const auto& set : mixer.weights()) weights.insert(weights.end(), set.begin(), set.end());
       finalModels->mixerUses[int(family)] = mixer.uses();
     };
-    keepMixer(MixerFamily::OneVertexSplits, predictor.mixer());
+    keepMixer(MixerFamily::OneVertexSplits, predictor.mixer(MixerFamily::OneVertexSplits));
+    keepMixer(MixerFamily::OneVertexByParallelogram, predictor.mixer(MixerFamily::OneVertexByParallelogram));
+    keepMixer(MixerFamily::OneVertexByPlaneAndCentroid, predictor.mixer(MixerFamily::OneVertexByPlaneAndCentroid));
     keepMixer(MixerFamily::CellCounts, counts.mixer());
   }
 

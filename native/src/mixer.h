@@ -68,18 +68,39 @@ class Mixer {
   // time: bunny 1.551 G instructions with it, 1.555 G without).
   const std::vector<uint32_t>& uses() const { return uses_; }
 
-  // P(bit == 0) in units of 2^-15 for the coder.
-  uint32_t mix(int set, const std::array<BitModel*, kInputs>& inputs) {
-    set_ = set;
-    ++uses_[size_t(set)];
-    int64_t dot = 0;
+  // The inputs' probabilities of 0 in the logistic domain.
+  static std::array<int, kInputs> stretch(const std::array<BitModel*, kInputs>& inputs) {
+    std::array<int, kInputs> stretched;
     for (int i = 0; i < kInputs; ++i) {
       const int p = int(inputs[size_t(i)]->probabilityOfZero() >> 3);
-      stretched_[size_t(i)] = Logistic::stretch(p < 1 ? 1 : p > 4095 ? 4095 : p);
-      dot += int64_t(weights_[size_t(set)][size_t(i)]) * stretched_[size_t(i)];
+      stretched[size_t(i)] = Logistic::stretch(p < 1 ? 1 : p > 4095 ? 4095 : p);
     }
-    mixed_ = Logistic::squash(int(dot >> 16));
-    const uint32_t p0 = uint32_t(mixed_) << 3;
+    return stretched;
+  }
+
+  // The mix of stretched inputs in the logistic domain, clamped to
+  // [-2047, 2047].
+  int logit(int set, const std::array<int, kInputs>& stretched) {
+    set_ = set;
+    ++uses_[size_t(set)];
+    stretched_ = stretched;
+    int64_t dot = 0;
+    for (int i = 0; i < kInputs; ++i) dot += int64_t(weights_[size_t(set)][size_t(i)]) * stretched[size_t(i)];
+    const int64_t d = dot >> 16;
+    const int clamped = int(d < -2047 ? -2047 : d > 2047 ? 2047 : d);
+    mixed_ = Logistic::squash(clamped);
+    return clamped;
+  }
+
+  // P(bit == 0) in units of 2^-15 for the coder.
+  uint32_t mix(int set, const std::array<BitModel*, kInputs>& inputs) {
+    logit(set, stretch(inputs));
+    return probabilityOfZero(mixed_);
+  }
+
+  // A squashed mix as P(0) in units of 2^-15, kept off certainty.
+  static uint32_t probabilityOfZero(int squashed) {
+    const uint32_t p0 = uint32_t(squashed) << 3;
     return p0 < 64 ? 64 : p0 > kProbabilityOne - 64 ? kProbabilityOne - 64 : p0;
   }
 
@@ -107,5 +128,27 @@ class Mixer {
   std::array<int, kInputs> stretched_{};
   int mixed_ = 2048, set_ = 0;
 };
+
+// Codes `bit` (encoder; the decoder returns the decoded bit) with the mean,
+// in the logistic domain, of several mixers of the same inputs, each mixing
+// with the weight vector `sets[i]` chosen by a context of its own: each
+// learns how far to trust the inputs in its context, and the mean of their
+// views predicts better than any one of them (one-vertex splits: bunny
+// −0.07 bits per vertex, fandisk −0.13, before learning the new mixers'
+// starting weights). Then the inputs and every mixer update.
+template <class Coder, int kInputs, size_t kMixers>
+bool codeWithMixers(Coder& coder, const std::array<Mixer<kInputs>*, kMixers>& mixers,
+                    const std::array<int, kMixers>& sets, const std::array<BitModel*, kInputs>& inputs,
+                    bool bit) {
+  const std::array<int, kInputs> stretched = Mixer<kInputs>::stretch(inputs);
+  int sum = 0;
+  for (size_t m = 0; m < kMixers; ++m) sum += mixers[m]->logit(sets[m], stretched);
+  // Integer division truncates towards zero on every platform.
+  const int mean = sum / int(kMixers);
+  bit = coder.bitWithProbability(Mixer<kInputs>::probabilityOfZero(Logistic::squash(mean)), bit);
+  for (BitModel* model : inputs) model->update(bit);
+  for (Mixer<kInputs>* mixer : mixers) mixer->update(bit);
+  return bit;
+}
 
 }  // namespace kdmesh

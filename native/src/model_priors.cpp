@@ -11,11 +11,15 @@ namespace {
 // kOneVertexByParallelogramPriors, kCellCountByParallelogramPriors,
 // kEdgeCodeByBalancePriors: P(bit == 0) in units of 2^-15, one per model,
 // run-length coded (model_priors.h);
-// kOneVertexMixerPriors, kCellCountMixerPriors: starting mixer weights.
+// kOneVertexMixerPriors, kCellCountMixerPriors,
+// kOneVertexByParallelogramMixerPriors,
+// kOneVertexByPlaneAndCentroidMixerPriors: starting mixer weights.
 #include "model_priors.inc"
 
 static_assert(std::size(kOneVertexMixerPriors) == kMixerSets[0] * kMixerInputs[0]);
 static_assert(std::size(kCellCountMixerPriors) == kMixerSets[1] * kMixerInputs[1]);
+static_assert(std::size(kOneVertexByParallelogramMixerPriors) == kMixerSets[2] * kMixerInputs[2]);
+static_assert(std::size(kOneVertexByPlaneAndCentroidMixerPriors) == kMixerSets[3] * kMixerInputs[3]);
 
 // How many models a run-length coded family primes.
 template <size_t kCoded>
@@ -54,7 +58,10 @@ constexpr CodedFamily codedFamily(const uint16_t (&coded)[kCoded]) {
 }  // namespace
 
 const int32_t* mixerPriors(MixerFamily family) {
-  return family == MixerFamily::OneVertexSplits ? kOneVertexMixerPriors : kCellCountMixerPriors;
+  static constexpr const int32_t* kPriors[kMixerFamilies] = {kOneVertexMixerPriors, kCellCountMixerPriors,
+                                                             kOneVertexByParallelogramMixerPriors,
+                                                             kOneVertexByPlaneAndCentroidMixerPriors};
+  return kPriors[int(family)];
 }
 
 void primeModels(ModelFamily family, BitModel* models) {

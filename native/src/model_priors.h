@@ -48,11 +48,14 @@ constexpr uint16_t kPriorObservations = 24;
 // weights of each weight vector, averaged over the training meshes by how
 // often the vector was used): a small model's mixer codes many of its bits
 // before its weights have moved far from any fixed start (triceratops −0.06
-// bits per vertex, fandisk −0.02).
-enum class MixerFamily { OneVertexSplits, CellCounts };
-constexpr int kMixerFamilies = 2;
-constexpr std::array<size_t, kMixerFamilies> kMixerSets = {45, 39};
-constexpr std::array<size_t, kMixerFamilies> kMixerInputs = {4, 3};
+// bits per vertex, fandisk −0.02). One-vertex splits average three mixers
+// (codeWithMixers in mixer.h), with weight vectors chosen by the
+// neighbourhood's scale, elongation and agreement, by the parallelogram
+// bucket, and by the centroid and plane buckets.
+enum class MixerFamily { OneVertexSplits, CellCounts, OneVertexByParallelogram, OneVertexByPlaneAndCentroid };
+constexpr int kMixerFamilies = 4;
+constexpr std::array<size_t, kMixerFamilies> kMixerSets = {45, 39, 12, 60};
+constexpr std::array<size_t, kMixerFamilies> kMixerInputs = {4, 3, 4, 4};
 // The starting weights of a mixer family: kMixerSets × kMixerInputs values,
 // weight vector by weight vector, in units of 2^-16.
 const int32_t* mixerPriors(MixerFamily family);

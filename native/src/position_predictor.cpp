@@ -156,7 +156,9 @@ PositionPredictor::PositionPredictor(const SplitSchedule& schedule, const Simple
       planeModels_(size_t(kOutsideClasses) * kScaleClasses * kTiltClasses * kPlaneBuckets),
       centroidModels_(size_t(kValenceClasses) * kScaleClasses * kCentroidBuckets),
       parallelogramModels_(size_t(kPlaneBuckets) * kSpreadClasses * kParallelogramBuckets),
-      mixer_(kElongationGroups * kScaleClasses * kAgreementClasses, mixerPriors(MixerFamily::OneVertexSplits)) {
+      mixer_(kElongationGroups * kScaleClasses * kAgreementClasses, mixerPriors(MixerFamily::OneVertexSplits)),
+      parallelogramMixer_(kParallelogramBuckets, mixerPriors(MixerFamily::OneVertexByParallelogram)),
+      planeAndCentroidMixer_(kCentroidBuckets * kPlaneBuckets, mixerPriors(MixerFamily::OneVertexByPlaneAndCentroid)) {
   static_assert(size_t(kJointValenceClasses) * kOutsideClasses * kScaleClasses * kTiltClasses * kPlaneBuckets *
                     kCentroidBuckets ==
                 kFamilySize[int(ModelFamily::OneVertexSplits)]);
@@ -169,6 +171,10 @@ PositionPredictor::PositionPredictor(const SplitSchedule& schedule, const Simple
   static_assert(size_t(kElongationGroups) * kScaleClasses * kAgreementClasses ==
                     kMixerSets[int(MixerFamily::OneVertexSplits)] &&
                 kMixerInputs[int(MixerFamily::OneVertexSplits)] == 4);
+  static_assert(kParallelogramBuckets == kMixerSets[int(MixerFamily::OneVertexByParallelogram)] &&
+                kMixerInputs[int(MixerFamily::OneVertexByParallelogram)] == 4);
+  static_assert(kCentroidBuckets * kPlaneBuckets == kMixerSets[int(MixerFamily::OneVertexByPlaneAndCentroid)] &&
+                kMixerInputs[int(MixerFamily::OneVertexByPlaneAndCentroid)] == 4);
   primeModels(ModelFamily::OneVertexSplits, models_.data());
   primeModels(ModelFamily::OneVertexByPlane, planeModels_.data());
   primeModels(ModelFamily::OneVertexByCentroid, centroidModels_.data());
@@ -350,6 +356,8 @@ bool PositionPredictor::contextsOf(uint32_t vertex, int level, SingleContexts& c
   // within about 1.4 half widths, farther, or no prediction.
   const int agreement = !f.hasParallelogram ? 2 : f.parallelogramSpread < 2 ? 0 : 1;
   c.mixerSet = (f.elongation * kScaleClasses + scale) * kAgreementClasses + agreement;
+  c.parallelogramMixerSet = f.parallelogram;
+  c.planeAndCentroidMixerSet = centroid * kPlaneBuckets + plane;
   c.parallelogram =
       (plane * kSpreadClasses + spreadClass(f.parallelogramSpread)) * kParallelogramBuckets + f.parallelogram;
   parallelogramPredictions_ += f.hasParallelogram;

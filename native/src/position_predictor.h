@@ -59,6 +59,7 @@
 #include "count_coder.h"
 #include "kdmesh/kdmesh.h"
 #include "mixer.h"
+#include "model_priors.h"
 #include "range_coder.h"
 #include "simplex_store.h"
 #include "split_schedule.h"
@@ -111,11 +112,12 @@ class PositionPredictor {
     if (!contextsOf(vertex, level, c)) {
       first = counts.codeSingle(coder, level, parentOneSided, inFirstHalf);
     } else {
-      const bool bit = mixer_.code(coder, c.mixerSet,
-                                   {&models_[size_t(c.joint)], &planeModels_[size_t(c.plane)],
-                                    &centroidModels_[size_t(c.centroid)],
-                                    &parallelogramModels_[size_t(c.parallelogram)]},
-                                   inFirstHalf != c.mirrored);
+      const bool bit = codeWithMixers(
+          coder, std::array<Mixer<4>*, 3>{&mixer_, &parallelogramMixer_, &planeAndCentroidMixer_},
+          {c.mixerSet, c.parallelogramMixerSet, c.planeAndCentroidMixerSet},
+          {&models_[size_t(c.joint)], &planeModels_[size_t(c.plane)], &centroidModels_[size_t(c.centroid)],
+           &parallelogramModels_[size_t(c.parallelogram)]},
+          inFirstHalf != c.mirrored);
       first = bit != c.mirrored;
     }
     // The half's centre lies a quarter of the cell's width below or above.
@@ -144,7 +146,12 @@ class PositionPredictor {
   const std::vector<BitModel>& planeModels() const { return planeModels_; }
   const std::vector<BitModel>& centroidModels() const { return centroidModels_; }
   const std::vector<BitModel>& parallelogramModels() const { return parallelogramModels_; }
-  const Mixer<4>& mixer() const { return mixer_; }
+  // One of the three mixers of one-vertex splits.
+  const Mixer<4>& mixer(MixerFamily family) const {
+    return family == MixerFamily::OneVertexByParallelogram      ? parallelogramMixer_
+           : family == MixerFamily::OneVertexByPlaneAndCentroid ? planeAndCentroidMixer_
+                                                                : mixer_;
+  }
 
   // Adds the prediction counters to `statistics`.
   void addStatistics(ConnectivityStatistics& statistics) const {
@@ -203,11 +210,13 @@ class PositionPredictor {
   static constexpr uint32_t kUnknown = 0xffffffffu, kNowhere = 0xfffffffeu;
   // The models of a one-vertex split: one for the joint class of all
   // features, one for the plane's alone, one for the centroid's alone, one
-  // for the parallelogram predictions (with the plane's offset), mixed with
-  // weights chosen by the neighbours' distance and elongation and by how
-  // far the parallelogram predictions agree.
+  // for the parallelogram predictions (with the plane's offset); mixed by
+  // three mixers whose weights are chosen by the neighbours' distance and
+  // elongation and by how far the parallelogram predictions agree, by the
+  // parallelogram bucket, and by the centroid and plane buckets.
   struct SingleContexts {
-    int joint, plane, centroid, parallelogram, mixerSet;
+    int joint, plane, centroid, parallelogram;
+    int mixerSet, parallelogramMixerSet, planeAndCentroidMixerSet;
     bool mirrored;
   };
   bool contextsOf(uint32_t vertex, int level, SingleContexts& contexts);
@@ -231,7 +240,7 @@ class PositionPredictor {
   // The parallelogram predictions of one gather(), and their deviations.
   std::vector<double> predictions_;
   std::vector<BitModel> models_, planeModels_, centroidModels_, parallelogramModels_;
-  Mixer<4> mixer_;
+  Mixer<4> mixer_, parallelogramMixer_, planeAndCentroidMixer_;
   uint64_t countPredictions_ = 0;
   uint64_t positionPredictions_ = 0;
   uint64_t parallelogramPredictions_ = 0;

@@ -33,7 +33,9 @@ constexpr const char* kNames[kFamilies] = {"kOneVertexSplitPriors", "kEdgeCodePr
                                            "kTriangleCodePriors", "kOneVertexByParallelogramPriors",
                                            "kCellCountByParallelogramPriors", "kEdgeCodeByBalancePriors",
                                            "kOneVertexMixerPriors",
-                                           "kCellCountMixerPriors"};
+                                           "kCellCountMixerPriors",
+                                           "kOneVertexByParallelogramMixerPriors",
+                                           "kOneVertexByPlaneAndCentroidMixerPriors"};
 
 }  // namespace
 

@@ -1,7 +1,9 @@
 // The logistic mixer of the one-vertex split predictions.
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cstdint>
+#include <vector>
 
 #include "mixer.h"
 
@@ -61,6 +63,78 @@ TEST(Mixer, StartsFromGivenWeightsAndCountsUses) {
   EXPECT_EQ(mixer.uses()[0], 1u);
   EXPECT_EQ(mixer.uses()[1], 2u);
   EXPECT_EQ(mixer.uses()[2], 0u);
+}
+
+// A coder that keeps the probability it was given.
+struct ProbeCoder {
+  uint32_t probabilityOfZero = 0;
+  bool bitWithProbability(uint32_t p0, bool bit) {
+    probabilityOfZero = p0;
+    return bit;
+  }
+};
+
+TEST(Mixer, SeveralMixersCodeWithTheMeanOfTheirLogits) {
+  BitModel likelyZero, likelyOne;
+  likelyZero.fast = likelyZero.slow = uint16_t(0.8 * kProbabilityOne);
+  likelyOne.fast = likelyOne.slow = uint16_t(0.3 * kProbabilityOne);
+  // The first mixer's vector 1 follows the first input, the second mixer's
+  // only vector the second input.
+  const int32_t first[4] = {0, 0, 1 << 16, 0}, second[2] = {0, 1 << 16};
+  Mixer<2> byFirst(2, first), bySecond(1, second);
+  const int stretchedZero = Logistic::stretch(int(likelyZero.probabilityOfZero() >> 3));
+  const int stretchedOne = Logistic::stretch(int(likelyOne.probabilityOfZero() >> 3));
+  ProbeCoder probe;
+  EXPECT_FALSE(codeWithMixers(probe, std::array<Mixer<2>*, 2>{&byFirst, &bySecond}, {1, 0},
+                              {&likelyZero, &likelyOne}, false));
+  EXPECT_EQ(probe.probabilityOfZero,
+            Mixer<2>::probabilityOfZero(Logistic::squash((stretchedZero + stretchedOne) / 2)));
+  // Each mixer used and trained the vector its context chose; the inputs learned the 0.
+  EXPECT_EQ(byFirst.uses()[0], 0u);
+  EXPECT_EQ(byFirst.uses()[1], 1u);
+  EXPECT_EQ(bySecond.uses()[0], 1u);
+  EXPECT_EQ(byFirst.weights()[0][0], 0);
+  EXPECT_GT(byFirst.weights()[1][0], 1 << 16);
+  EXPECT_GT(likelyZero.probabilityOfZero(), uint32_t(0.8 * kProbabilityOne));
+}
+
+// What the encoder codes with the mean of three mixers, the decoder reads
+// back, whatever the contexts.
+TEST(Mixer, SeveralMixersRoundTripThroughTheRangeCoder) {
+  auto run = [](auto& coder, std::vector<bool>& bits) {
+    std::array<BitModel, 8> models;
+    Mixer<2> a(4, {1 << 15, 1 << 15}), b(3, {1 << 16, 0}), c(5, {0, 1 << 16});
+    uint32_t state = 99;
+    for (size_t i = 0; i < bits.size(); ++i) {
+      state = state * 1664525u + 1013904223u;
+      const uint32_t context = state >> 24;
+      bits[i] = codeWithMixers(coder, std::array<Mixer<2>*, 3>{&a, &b, &c},
+                               {int(context % 4), int(context % 3), int(context % 5)},
+                               {&models[context % 8], &models[(context >> 3) % 8]}, bits[i]);
+    }
+  };
+  // Bits that are 1 with probability (context % 8) / 8, the context being
+  // the one run() derives.
+  std::vector<bool> sent(5000), received(5000);
+  uint32_t state = 99, noise = 7;
+  for (size_t i = 0; i < sent.size(); ++i) {
+    state = state * 1664525u + 1013904223u;
+    noise = noise * 22695477u + 1u;
+    sent[i] = (noise >> 16) % 8 < (state >> 24) % 8;
+  }
+  std::vector<uint8_t> stream;
+  RangeEncoder encoder(stream);
+  encoder.restart();
+  std::vector<bool> coded = sent;
+  run(encoder, coded);
+  encoder.finish();
+  EXPECT_EQ(coded, sent);
+  EXPECT_LT(stream.size(), sent.size() / 8);  // the contexts carry information
+  RangeDecoder decoder;
+  decoder.start(stream.data(), stream.size());
+  run(decoder, received);
+  EXPECT_EQ(received, sent);
+  EXPECT_FALSE(decoder.invalid());
 }
 
 }  // namespace
