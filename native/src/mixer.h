@@ -50,6 +50,13 @@ inline constexpr StretchTable kStretchTable{};
 
 inline int Logistic::stretch(int p) { return kStretchTable.values[size_t(p)]; }
 
+template <int kInputs>
+class Mixer;
+template <class Coder, int kInputs, size_t kMixers>
+bool codeWithMixers(Coder& coder, const std::array<Mixer<kInputs>*, kMixers>& mixers,
+                    const std::array<int, kMixers>& sets, const std::array<BitModel*, kInputs>& inputs,
+                    bool bit);
+
 // Mixes kInputs models with one of `sets` weight vectors (in units of
 // 2^-16), which all start at `initial`, or start at `sets` × kInputs values
 // given vector by vector (learned offline: model_priors.h).
@@ -68,33 +75,24 @@ class Mixer {
   // time: bunny 1.551 G instructions with it, 1.555 G without).
   const std::vector<uint32_t>& uses() const { return uses_; }
 
-  // The inputs' probabilities of 0 in the logistic domain.
-  static std::array<int, kInputs> stretch(const std::array<BitModel*, kInputs>& inputs) {
-    std::array<int, kInputs> stretched;
+  // The mix of `inputs` in the logistic domain, clamped to [-2047, 2047].
+  int logit(int set, const std::array<BitModel*, kInputs>& inputs) {
     for (int i = 0; i < kInputs; ++i) {
       const int p = int(inputs[size_t(i)]->probabilityOfZero() >> 3);
-      stretched[size_t(i)] = Logistic::stretch(p < 1 ? 1 : p > 4095 ? 4095 : p);
+      stretched_[size_t(i)] = Logistic::stretch(p < 1 ? 1 : p > 4095 ? 4095 : p);
     }
-    return stretched;
+    return logitOfStretched(set);
   }
-
-  // The mix of stretched inputs in the logistic domain, clamped to
-  // [-2047, 2047].
+  // The same for inputs another mixer has stretched already.
   int logit(int set, const std::array<int, kInputs>& stretched) {
-    set_ = set;
-    ++uses_[size_t(set)];
     stretched_ = stretched;
-    int64_t dot = 0;
-    for (int i = 0; i < kInputs; ++i) dot += int64_t(weights_[size_t(set)][size_t(i)]) * stretched[size_t(i)];
-    const int64_t d = dot >> 16;
-    const int clamped = int(d < -2047 ? -2047 : d > 2047 ? 2047 : d);
-    mixed_ = Logistic::squash(clamped);
-    return clamped;
+    return logitOfStretched(set);
   }
+  const std::array<int, kInputs>& stretched() const { return stretched_; }
 
   // P(bit == 0) in units of 2^-15 for the coder.
   uint32_t mix(int set, const std::array<BitModel*, kInputs>& inputs) {
-    logit(set, stretch(inputs));
+    logit(set, inputs);
     return probabilityOfZero(mixed_);
   }
 
@@ -105,13 +103,11 @@ class Mixer {
   }
 
   // Codes `bit` (encoder; the decoder returns the decoded bit) with the mix
-  // of `inputs`, then updates the inputs and the weights.
+  // of `inputs`, then updates the inputs and the weights: codeWithMixers()
+  // with this mixer alone.
   template <class Coder>
   bool code(Coder& coder, int set, const std::array<BitModel*, kInputs>& inputs, bool bit) {
-    bit = coder.bitWithProbability(mix(set, inputs), bit);
-    for (BitModel* model : inputs) model->update(bit);
-    update(bit);
-    return bit;
+    return codeWithMixers<Coder, kInputs, 1>(coder, {this}, {set}, inputs, bit);
   }
 
   void update(bool bit) {
@@ -123,6 +119,17 @@ class Mixer {
   }
 
  private:
+  int logitOfStretched(int set) {
+    set_ = set;
+    ++uses_[size_t(set)];
+    int64_t dot = 0;
+    for (int i = 0; i < kInputs; ++i) dot += int64_t(weights_[size_t(set)][size_t(i)]) * stretched_[size_t(i)];
+    const int64_t d = dot >> 16;
+    const int clamped = int(d < -2047 ? -2047 : d > 2047 ? 2047 : d);
+    mixed_ = Logistic::squash(clamped);
+    return clamped;
+  }
+
   std::vector<std::array<int32_t, kInputs>> weights_;
   std::vector<uint32_t> uses_;
   std::array<int, kInputs> stretched_{};
@@ -132,18 +139,20 @@ class Mixer {
 // Codes `bit` (encoder; the decoder returns the decoded bit) with the mean,
 // in the logistic domain, of several mixers of the same inputs, each mixing
 // with the weight vector `sets[i]` chosen by a context of its own: each
-// learns how far to trust the inputs in its context, and the mean of their
-// views predicts better than any one of them (one-vertex splits with three
-// mixers, their starting weights learned: bunny −0.071 bits per vertex,
-// triceratops −0.077, fandisk −0.147, dragon −0.038). Then the inputs and
-// every mixer update, each mixer from its own logit's error.
+// learns how far to trust the inputs in its context (one-vertex splits
+// with three mixers, their starting weights learned, against the first
+// alone: bunny −0.071 bits per vertex, triceratops −0.077, fandisk −0.147,
+// dragon −0.038). Then the inputs and every mixer update, each mixer from
+// its own logit's error.
+// Inlined always: out of line, the range coder's state went through memory
+// at every bit (bunny decode +0.8 % instructions).
 template <class Coder, int kInputs, size_t kMixers>
-bool codeWithMixers(Coder& coder, const std::array<Mixer<kInputs>*, kMixers>& mixers,
-                    const std::array<int, kMixers>& sets, const std::array<BitModel*, kInputs>& inputs,
-                    bool bit) {
-  const std::array<int, kInputs> stretched = Mixer<kInputs>::stretch(inputs);
-  int sum = 0;
-  for (size_t m = 0; m < kMixers; ++m) sum += mixers[m]->logit(sets[m], stretched);
+[[gnu::always_inline]] inline bool codeWithMixers(Coder& coder, const std::array<Mixer<kInputs>*, kMixers>& mixers,
+                                                  const std::array<int, kMixers>& sets,
+                                                  const std::array<BitModel*, kInputs>& inputs, bool bit) {
+  // The first mixer stretches the inputs for all.
+  int sum = mixers[0]->logit(sets[0], inputs);
+  for (size_t m = 1; m < kMixers; ++m) sum += mixers[m]->logit(sets[m], mixers[0]->stretched());
   // Integer division truncates towards zero on every platform.
   const int mean = sum / int(kMixers);
   bit = coder.bitWithProbability(Mixer<kInputs>::probabilityOfZero(Logistic::squash(mean)), bit);
