@@ -332,6 +332,8 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
     keep(ModelFamily::EdgeCodesByDirection, splitter.edgeDirectionModels());
     keep(ModelFamily::EdgeCodesByBalance, splitter.edgeBalanceModels());
     keep(ModelFamily::TriangleCodes, splitter.triangleModels());
+    keep(ModelFamily::EdgeCodesByRun, splitter.edgeRunModels());
+    keep(ModelFamily::VertexCodes, splitter.vertexModels());
     auto keepMixer = [&](MixerFamily family, const auto& mixer) {
       std::vector<int32_t>& weights = finalModels->mixerWeights[int(family)];
       weights.clear();
@@ -342,6 +344,7 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
     keepMixer(MixerFamily::OneVertexByParallelogram, predictor.mixer(MixerFamily::OneVertexByParallelogram));
     keepMixer(MixerFamily::OneVertexByPlaneAndCentroid, predictor.mixer(MixerFamily::OneVertexByPlaneAndCentroid));
     keepMixer(MixerFamily::CellCounts, counts.mixer());
+    keepMixer(MixerFamily::EdgeCodes, splitter.edgeMixer());
   }
 
   predictor.addStatistics(result.statistics);

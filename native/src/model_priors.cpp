@@ -1,6 +1,9 @@
 #include "model_priors.h"
 
+#include <algorithm>
 #include <iterator>
+
+#include "mixer.h"
 
 namespace kdmesh {
 namespace {
@@ -9,25 +12,31 @@ namespace {
 // kOneVertexByPlanePriors, kOneVertexByCentroidPriors,
 // kEdgeCodeByDirectionPriors, kTriangleCodePriors,
 // kOneVertexByParallelogramPriors, kCellCountByParallelogramPriors,
-// kEdgeCodeByBalancePriors: P(bit == 0) in units of 2^-15, one per model,
-// run-length coded (model_priors.h);
+// kEdgeCodeByBalancePriors, kEdgeCodeByRunPriors, kVertexCodePriors: P(bit ==
+// 0) as priorCode(), one byte per model, run-length coded (model_priors.h);
 // kOneVertexMixerPriors, kCellCountMixerPriors,
 // kOneVertexByParallelogramMixerPriors,
-// kOneVertexByPlaneAndCentroidMixerPriors: starting mixer weights.
+// kOneVertexByPlaneAndCentroidMixerPriors, kEdgeCodeMixerPriors: starting
+// mixer weights.
 #include "model_priors.inc"
 
 static_assert(std::size(kOneVertexMixerPriors) == kMixerSets[0] * kMixerInputs[0]);
 static_assert(std::size(kCellCountMixerPriors) == kMixerSets[1] * kMixerInputs[1]);
 static_assert(std::size(kOneVertexByParallelogramMixerPriors) == kMixerSets[2] * kMixerInputs[2]);
 static_assert(std::size(kOneVertexByPlaneAndCentroidMixerPriors) == kMixerSets[3] * kMixerInputs[3]);
+static_assert(std::size(kEdgeCodeMixerPriors) == kMixerSets[4] * kMixerInputs[4]);
+
+// The length of the run whose marker is at coded[i].
+constexpr size_t runLength(const uint8_t* coded, size_t i) { return size_t(coded[i + 1]) | size_t(coded[i + 2]) << 8; }
 
 // How many models a run-length coded family primes.
 template <size_t kCoded>
-constexpr size_t expandedSize(const uint16_t (&coded)[kCoded]) {
+constexpr size_t expandedSize(const uint8_t (&coded)[kCoded]) {
   size_t models = 0;
   for (size_t i = 0; i < kCoded; ++i) {
     if (coded[i] == kPriorRunMarker) {
-      models += coded[++i];
+      models += runLength(coded, i);
+      i += 2;
     } else {
       ++models;
     }
@@ -45,22 +54,43 @@ static_assert(expandedSize(kTriangleCodePriors) == kFamilySize[6]);
 static_assert(expandedSize(kOneVertexByParallelogramPriors) == kFamilySize[7]);
 static_assert(expandedSize(kCellCountByParallelogramPriors) == kFamilySize[8]);
 static_assert(expandedSize(kEdgeCodeByBalancePriors) == kFamilySize[9]);
+static_assert(expandedSize(kEdgeCodeByRunPriors) == kFamilySize[10]);
+static_assert(expandedSize(kVertexCodePriors) == kFamilySize[11]);
 
 struct CodedFamily {
-  const uint16_t* values;
+  const uint8_t* values;
   size_t size;
 };
 template <size_t kCoded>
-constexpr CodedFamily codedFamily(const uint16_t (&coded)[kCoded]) {
+constexpr CodedFamily codedFamily(const uint8_t (&coded)[kCoded]) {
   return {coded, kCoded};
 }
 
 }  // namespace
 
+// The nearest code (the first of equals): the inverse of priorOfCode(), so
+// that writing compiled priors back gives the same codes.
+uint8_t priorCode(uint32_t probabilityOfZero) {
+  uint8_t best = 1;
+  for (int code = 2; code <= 255; ++code) {
+    const auto distance = [probabilityOfZero](int c) {
+      return std::abs(int(priorOfCode(uint8_t(c))) - int(probabilityOfZero));
+    };
+    if (distance(code) < distance(best)) best = uint8_t(code);
+  }
+  return best;
+}
+
+uint16_t priorOfCode(uint8_t code) {
+  const uint32_t p = uint32_t(Logistic::squash((int(code) - 128) * 16)) << 3;
+  return uint16_t(std::clamp<uint32_t>(p, 31, kProbabilityOne - 31));
+}
+
 const int32_t* mixerPriors(MixerFamily family) {
   static constexpr const int32_t* kPriors[kMixerFamilies] = {kOneVertexMixerPriors, kCellCountMixerPriors,
                                                              kOneVertexByParallelogramMixerPriors,
-                                                             kOneVertexByPlaneAndCentroidMixerPriors};
+                                                             kOneVertexByPlaneAndCentroidMixerPriors,
+                                                             kEdgeCodeMixerPriors};
   return kPriors[int(family)];
 }
 
@@ -70,7 +100,8 @@ void primeModels(ModelFamily family, BitModel* models) {
       codedFamily(kCellCountPriors),           codedFamily(kOneVertexByPlanePriors),
       codedFamily(kOneVertexByCentroidPriors), codedFamily(kEdgeCodeByDirectionPriors),
       codedFamily(kTriangleCodePriors),        codedFamily(kOneVertexByParallelogramPriors),
-      codedFamily(kCellCountByParallelogramPriors), codedFamily(kEdgeCodeByBalancePriors)};
+      codedFamily(kCellCountByParallelogramPriors), codedFamily(kEdgeCodeByBalancePriors),
+      codedFamily(kEdgeCodeByRunPriors), codedFamily(kVertexCodePriors)};
   const CodedFamily& coded = kPriors[int(family)];
   auto prime = [&models](uint16_t prior) {
     models->fast = models->slow = prior;
@@ -79,9 +110,10 @@ void primeModels(ModelFamily family, BitModel* models) {
   };
   for (size_t i = 0; i < coded.size; ++i) {
     if (coded.values[i] == kPriorRunMarker) {
-      for (uint16_t run = coded.values[++i]; run > 0; --run) prime(uint16_t(kProbabilityOne / 2));
+      for (size_t run = runLength(coded.values, i); run > 0; --run) prime(uint16_t(kProbabilityOne / 2));
+      i += 2;
     } else {
-      prime(coded.values[i]);
+      prime(priorOfCode(coded.values[i]));
     }
   }
 }

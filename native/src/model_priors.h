@@ -30,15 +30,26 @@ enum class ModelFamily {
   OneVertexByParallelogram,
   CellCountsByParallelogram,
   EdgeCodesByBalance,
+  EdgeCodesByRun,
+  VertexCodes,
 };
-constexpr int kModelFamilies = 10;
-constexpr std::array<size_t, kModelFamilies> kFamilySize = {9000, 11760, 3042, 300, 250, 294, 864, 648, 768, 2646};
+constexpr int kModelFamilies = 12;
+constexpr std::array<size_t, kModelFamilies> kFamilySize = {9000, 11760, 3042, 300, 250, 294, 864, 648, 768, 2646, 1980, 36};
 
 // model_priors.inc holds each family run-length coded: half the models of
 // the large families were never used in training and start at 1/2; a run of
-// them is the pair (kPriorRunMarker, run length). Priors are clamped to
-// [31, 2^15 - 31], so the marker is no prior.
-constexpr uint16_t kPriorRunMarker = 0;
+// them is kPriorRunMarker followed by the run's length in two bytes, low
+// byte first. Prior codes are 1..255, so the marker is no prior.
+constexpr uint8_t kPriorRunMarker = 0;
+
+// Priors are stored one byte each, as their logit: code q stands for
+// P(0) = squash((q − 128) · 16) · 8 in units of 2^-15 (mixer.h's logistic
+// functions, exact integers), q in 1..255; 128 is exactly 1/2. Half the
+// size of 15-bit probabilities in the WebAssembly module, and no coarser
+// where it matters: near 0 and 1 the steps are finer than in probability.
+constexpr uint8_t kHalfPriorCode = 128;
+uint8_t priorCode(uint32_t probabilityOfZero);
+uint16_t priorOfCode(uint8_t code);
 
 // As many observations as a prior is worth: the slow estimator then starts
 // at a moderate rate and still follows the model at hand.
@@ -51,11 +62,12 @@ constexpr uint16_t kPriorObservations = 24;
 // bits per vertex, fandisk −0.02). One-vertex splits average three mixers
 // (codeWithMixers in mixer.h), with weight vectors chosen by the
 // neighbourhood's scale, elongation and agreement, by the parallelogram
-// bucket, and by the centroid and plane buckets.
-enum class MixerFamily { OneVertexSplits, CellCounts, OneVertexByParallelogram, OneVertexByPlaneAndCentroid };
-constexpr int kMixerFamilies = 4;
-constexpr std::array<size_t, kMixerFamilies> kMixerSets = {45, 39, 12, 60};
-constexpr std::array<size_t, kMixerFamilies> kMixerInputs = {4, 3, 4, 4};
+// bucket, and by the centroid and plane buckets; edge codes mix four rows
+// of models (VertexSplitter::split).
+enum class MixerFamily { OneVertexSplits, CellCounts, OneVertexByParallelogram, OneVertexByPlaneAndCentroid, EdgeCodes };
+constexpr int kMixerFamilies = 5;
+constexpr std::array<size_t, kMixerFamilies> kMixerSets = {45, 39, 12, 60, 8};
+constexpr std::array<size_t, kMixerFamilies> kMixerInputs = {4, 3, 4, 4, 4};
 // The starting weights of a mixer family: kMixerSets × kMixerInputs values,
 // weight vector by weight vector, in units of 2^-16.
 const int32_t* mixerPriors(MixerFamily family);

@@ -81,6 +81,7 @@ struct StarEntry {
   // and how many between them and another cut edge are still to be coded.
   uint8_t addedTriangles;
   uint16_t pairedTriangles;
+  uint8_t fanIndex;  // edges of a closed fan: position around it
   // Edges: star indices of two edges sharing a triangle with this one;
   // triangles: of their two edges through the vertex. kNoSimplex if none.
   uint32_t links[2];
@@ -94,6 +95,9 @@ void gatherStar(SimplexStore& store, uint32_t v, std::vector<StarEntry>& star,
 
 class VertexSplitter {
  public:
+  // Rows of models an edge code mixes (split()).
+  static constexpr int kEdgeInputs = 4;
+
   // `geometry` knows where the cells are; the split of a cell at a
   // geometric level puts v in its first half and v2 in the second, which
   // predicts where v's edges go. A split tells `geometry` which triangles
@@ -109,6 +113,11 @@ class VertexSplitter {
     primeModels(ModelFamily::EdgeCodesByBalance, edgeBalanceModels());
     static_assert(sizeof(triangleModels_[0]) / sizeof(BitModel) == kFamilySize[int(ModelFamily::TriangleCodes)]);
     for (auto& models : triangleModels_) primeModels(ModelFamily::TriangleCodes, &models[0][0][0]);
+    static_assert(sizeof(edgeRunModels_) / sizeof(BitModel) == kFamilySize[int(ModelFamily::EdgeCodesByRun)]);
+    primeModels(ModelFamily::EdgeCodesByRun, edgeRunModels());
+    static_assert(sizeof(vertexModels_) / sizeof(BitModel) == kFamilySize[int(ModelFamily::VertexCodes)]);
+    primeModels(ModelFamily::VertexCodes, vertexModels());
+    static_assert(kMixerSets[int(MixerFamily::EdgeCodes)] == 8 && kMixerInputs[int(MixerFamily::EdgeCodes)] == kEdgeInputs);
   }
 
   // Splits `v`, whose cell is at `level`, into `v` and `v2`; `balance`:
@@ -124,6 +133,9 @@ class VertexSplitter {
   BitModel* edgeDirectionModels() { return &edgeDirectionModels_[0][0][0]; }
   BitModel* edgeBalanceModels() { return &edgeBalanceModels_[0][0][0][0]; }
   BitModel* triangleModels() { return &triangleModels_[0][0][0][0]; }
+  BitModel* edgeRunModels() { return &edgeRunModels_[0][0][0]; }
+  BitModel* vertexModels() { return &vertexModels_[0][0]; }
+  const Mixer<kEdgeInputs>& edgeMixer() const { return edgeMixer_; }
 
  private:
   using Entry = StarEntry;
@@ -143,14 +155,31 @@ class VertexSplitter {
   void classifyEdges(uint32_t v, int level);
   void orderCodes(bool geometric);
   void linkFans();
+  void indexFan();
   size_t countPairedTriangles();
   static constexpr int kUnpaired = 0x7fffffff;
   int pairingSlack(const Entry& triangle) const;
   void takeMostConstrainedTriangle(size_t step);
   int triangleClass(const Entry& triangle) const;
+  // Codes a symbol among the `possible` codes by sequential binarisation
+  // (step s: is it the s-th candidate?), `codeBit(step, bit)` coding each
+  // binary decision.
+  template <class CodeBit>
+  static uint8_t binarise(uint8_t possible, uint8_t code, CodeBit&& codeBit);
   template <class Coder>
-  uint8_t codeSymbol(Coder& coder, BitModel (&models)[3], uint8_t possible, uint8_t code,
-                     BitModel* mixedWith = nullptr, BitModel* mixedThird = nullptr, int mixerSet = 0);
+  uint8_t codeSymbol(Coder& coder, BitModel (&models)[3], uint8_t possible, uint8_t code) {
+    return binarise(possible, code, [&](int step, bool bit) { return coder.bit(models[step], bit); });
+  }
+  // Edges: kEdgeInputs rows of models mixed with the weight vector `mixerSet`.
+  template <class Coder>
+  uint8_t codeEdgeSymbol(Coder& coder, const std::array<BitModel*, kEdgeInputs>& rows, int mixerSet,
+                         uint8_t possible, uint8_t code) {
+    return binarise(possible, code, [&](int step, bool bit) {
+      return edgeMixer_.code(coder, mixerSet, {&rows[0][step], &rows[1][step], &rows[2][step], &rows[3][step]}, bit);
+    });
+  }
+  int runClass(const Entry& edge, int cutEdges, bool mirrored);
+  int vertexClass(int balance) const;
   template <class Coder>
   void decideOrientation(Coder& coder, int dimension, uint32_t simplex, bool isCopy, uint8_t target);
   int predictFlip(int dimension, uint32_t simplex, int& voteClass);
@@ -176,6 +205,10 @@ class VertexSplitter {
   const std::vector<uint32_t>& around(int dimension);
   // Code models: [dimension][possible set][step of the sequential binarisation].
   BitModel codeModels_[4][16][3];
+  // Whether v and v2 are joined (the vertex's code, 3 or 4) by the shape of
+  // the star (see vertexClass()).
+  static constexpr int kVertexClasses = 12;
+  BitModel vertexModels_[kVertexClasses][3];
   // Triangles at geometric levels: [pairing class (see split())][class of
   // their two other vertices' directions][possible set][step] (what
   // separates a tetrahedral mesh's star in two).
@@ -203,27 +236,29 @@ class VertexSplitter {
   static constexpr int kBalanceClasses = 9;
   BitModel edgeBalanceModels_[kBalanceClasses][kEdgeClasses][2][3];
   BitModel neutral_[3];
-  Mixer<3> edgeMixer_{4, {45875, 19661, 16384}};
+  Mixer<kEdgeInputs> edgeMixer_{8, mixerPriors(MixerFamily::EdgeCodes)};
+  // Edges by where they lie in the star's fan (runClass()), mixed in fourth.
+  static constexpr int kRunClasses = 66, kCutBands = 5;
+  BitModel edgeRunModels_[kCutBands * kRunClasses][2][3];
+  // The star's shape (linkFans): extra fan neighbours beyond two per edge,
+  // and, when its edges form one closed fan, their order around it.
+  int crowdedLinks_ = 0;
+  int fanSize_ = 0;  // edges around the closed fan, 0 if the star is not one
+  std::vector<uint32_t> fanOrder_;
+  int firstCut_ = -1;     // fan position of the first edge coded 3 or 4
+  double halfWidth_ = 0;  // of the split cell along the split axis (0: not geometric)
   // Orientation models: [dimension - 2][copy or new][vote class][face of higher].
   BitModel orientationModels_[2][2][3][2];
   ConnectivityStatistics statistics_;
 };
 
-// `mixedWith`, `mixedThird`: two more rows of models, mixed with the first.
-template <class Coder>
-uint8_t VertexSplitter::codeSymbol(Coder& coder, BitModel (&models)[3], uint8_t possible, uint8_t code,
-                                   BitModel* mixedWith, BitModel* mixedThird, int mixerSet) {
+template <class CodeBit>
+uint8_t VertexSplitter::binarise(uint8_t possible, uint8_t code, CodeBit&& codeBit) {
   int step = 0;
   for (uint8_t c = 1; c <= 4; ++c) {
     if (!(possible & (1u << (c - 1)))) continue;
     if ((possible >> c) == 0) return c;  // the last candidate left
-    bool bit = c == code;
-    if (mixedWith) {
-      bit = edgeMixer_.code(coder, mixerSet, {&models[step], &mixedWith[step], &mixedThird[step]}, bit);
-    } else {
-      bit = coder.bit(models[step], bit);
-    }
-    if (bit) return c;
+    if (codeBit(step, c == code)) return c;
     ++step;
   }
   return 0;  // unreachable: `possible` is never empty here
@@ -285,12 +320,18 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int
       // vertex; surfaces lose by it, their split is not symmetric enough).
       const bool mirrored = volume && geometric && cosines_[index - begin_[1]] > 0;
       if (volume) std::fill(neutral_, neutral_ + 3, BitModel{});
+      // Weight vectors by cut state (the last two share one) and whether
+      // the star is one closed fan.
+      const int mixerSet = std::min(cutState, 3) + 4 * (fanSize_ > 0);
       entry.code = mirrorCode(
-          codeSymbol(coder, edgeModels_[cutState][mirrorSet(entry.fanCodes, mirrored)][entry.geometry][all],
-                     mirrorSet(possible, mirrored), mirrorCode(code, mirrored),
-                     edgeDirectionModels_[entry.geometry][all],
-                     volume ? neutral_ : edgeBalanceModels_[balance][entry.geometry][all], std::min(cutState, 3)),
+          codeEdgeSymbol(coder,
+                         {edgeModels_[cutState][mirrorSet(entry.fanCodes, mirrored)][entry.geometry][all],
+                          edgeDirectionModels_[entry.geometry][all],
+                          volume ? neutral_ : edgeBalanceModels_[balance][entry.geometry][all],
+                          edgeRunModels_[runClass(entry, cutEdges, mirrored)][all]},
+                         mixerSet, mirrorSet(possible, mirrored), mirrorCode(code, mirrored)),
           mirrored);
+      if (entry.code == 4 && cutEdges == 0) firstCut_ = entry.fanIndex;
       cutEdges += entry.code == 4;
       const uint8_t bit = uint8_t(1u << std::min(entry.code - 1, 2));
       if (crowdedFans_) {
@@ -328,6 +369,8 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int
         ++first.addedTriangles;
         ++second.addedTriangles;
       }
+    } else if (entry.dimension == 0) {
+      entry.code = codeSymbol(coder, vertexModels_[vertexClass(balance)], possible, code);
     } else {
       entry.code = codeSymbol(coder, codeModels_[entry.dimension][possible], possible, code);
     }

@@ -32,10 +32,12 @@ constexpr const char* kNames[kFamilies] = {"kOneVertexSplitPriors", "kEdgeCodePr
                                            "kOneVertexByCentroidPriors", "kEdgeCodeByDirectionPriors",
                                            "kTriangleCodePriors", "kOneVertexByParallelogramPriors",
                                            "kCellCountByParallelogramPriors", "kEdgeCodeByBalancePriors",
+                                           "kEdgeCodeByRunPriors", "kVertexCodePriors",
                                            "kOneVertexMixerPriors",
                                            "kCellCountMixerPriors",
                                            "kOneVertexByParallelogramMixerPriors",
-                                           "kOneVertexByPlaneAndCentroidMixerPriors"};
+                                           "kOneVertexByPlaneAndCentroidMixerPriors",
+                                           "kEdgeCodeMixerPriors"};
 
 }  // namespace
 
@@ -114,26 +116,29 @@ int main(int argc, char** argv) {
   for (int f = 0; f < kdmesh::kModelFamilies; ++f) {
     std::vector<kdmesh::BitModel> compiled(kdmesh::kFamilySize[size_t(f)]);
     kdmesh::primeModels(kdmesh::ModelFamily(f), compiled.data());
-    // Run-length form (model_priors.h): a run of models at 1/2 becomes the
-    // pair (kPriorRunMarker, length).
+    // One byte per prior (model_priors.h), and a run of models at 1/2 as
+    // the marker and the run's length in two bytes.
     std::vector<int> coded;
+    size_t runAt = 0;  // of the current run's marker, if coded ends in a run
     for (size_t m = 0; m < kdmesh::kFamilySize[size_t(f)]; ++m) {
       const double w = weight[size_t(f)][m];
-      const int prior = std::clamp(!retrain[size_t(f)] ? int(compiled[m].slow)
-                                   : w > 0         ? int(sum[size_t(f)][m] / w + 0.5)
-                                                   : int(kdmesh::kProbabilityOne / 2),
-                                   31, int(kdmesh::kProbabilityOne) - 31);
-      const bool half = prior == int(kdmesh::kProbabilityOne / 2);
-      if (half && coded.size() >= 2 && coded[coded.size() - 2] == kdmesh::kPriorRunMarker &&
-          coded.back() < 0xffff) {
-        ++coded.back();
-      } else if (half) {
-        coded.insert(coded.end(), {kdmesh::kPriorRunMarker, 1});
+      const int prior = !retrain[size_t(f)] ? int(compiled[m].slow)
+                        : w > 0         ? int(sum[size_t(f)][m] / w + 0.5)
+                                        : int(kdmesh::kProbabilityOne / 2);
+      const int code = kdmesh::priorCode(uint32_t(prior));
+      const bool inRun = coded.size() >= 3 && runAt == coded.size() - 3;
+      const int runLength = inRun ? coded[runAt + 1] | coded[runAt + 2] << 8 : 0;
+      if (code == kdmesh::kHalfPriorCode && inRun && runLength < 0xffff) {
+        coded[runAt + 1] = (runLength + 1) & 0xff;
+        coded[runAt + 2] = (runLength + 1) >> 8;
+      } else if (code == kdmesh::kHalfPriorCode) {
+        runAt = coded.size();
+        coded.insert(coded.end(), {kdmesh::kPriorRunMarker, 1, 0});
       } else {
-        coded.push_back(prior);
+        coded.push_back(code);
       }
     }
-    std::fprintf(out, "constexpr uint16_t %s[%zu] = {", kNames[f], coded.size());
+    std::fprintf(out, "constexpr uint8_t %s[%zu] = {", kNames[f], coded.size());
     for (size_t i = 0; i < coded.size(); ++i)
       std::fprintf(out, "%s%s%d", i ? "," : "", i % 16 == 0 ? "\n    " : " ", coded[i]);
     std::fprintf(out, "};\n");

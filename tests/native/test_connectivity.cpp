@@ -65,12 +65,18 @@ TEST(Connectivity, PredictorsRunAlikeOnBothSides) {
     EXPECT_EQ(theirs.parallelogramPredictions, mine.parallelogramPredictions);
     EXPECT_EQ(theirs.edgeExpansions, mine.edgeExpansions);
     EXPECT_EQ(theirs.pairedTriangles, mine.pairedTriangles);
+    EXPECT_EQ(theirs.closedFanEdgeCodes, mine.closedFanEdgeCodes);
+    EXPECT_EQ(theirs.cutCandidatePairs, mine.cutCandidatePairs);
     // Surfaces split mostly by edge expansions; tetrahedral meshes have
     // triangles between cut edges.
     if (c.surface) {
       EXPECT_GT(mine.edgeExpansions * 2, mine.vertexSplits);
       // Most vertices of a surface have triangles across their link.
       EXPECT_GT(mine.parallelogramPredictions * 2, mine.positionPredictions + mine.countPredictions);
+      // Inner vertices of a surface have closed fans, and their edge
+      // expansions leave two cut candidates between a 1 and a 2.
+      EXPECT_GT(mine.closedFanEdgeCodes, 0u);
+      EXPECT_GT(mine.cutCandidatePairs, 0u);
     } else {
       EXPECT_GT(mine.pairedTriangles, 0u);
     }

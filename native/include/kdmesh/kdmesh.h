@@ -181,6 +181,12 @@ struct ConnectivityStatistics {
   // Triangles between two edges coded 3 or 4, coded most constrained first
   // with the count of their edges' code-4 triangles (tetrahedral meshes).
   uint64_t pairedTriangles = 0;
+  // Edge codes of stars that are one closed fan, conditioned on the run of
+  // uncoded edges around the fan that holds the edge; of those, the codes
+  // of one of two candidates for a cut, conditioned on the Delaunay
+  // criterion and the two candidates' valences.
+  uint64_t closedFanEdgeCodes = 0;
+  uint64_t cutCandidatePairs = 0;
 };
 
 struct EncodeResult {
