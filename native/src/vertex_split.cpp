@@ -371,12 +371,11 @@ void VertexSplitter::indexFan() {
 
 namespace {
 
-// Edges classes of runClass(), kRunClasses in all.
+// Edge classes of runClass(), VertexSplitter::kRunClasses in all.
 constexpr int kOpenFanClasses = 32;               // fan codes × in 3+ triangles × v v2 joined
 constexpr int kUncodedFan = kOpenFanClasses;      // a closed fan with no code yet
 constexpr int kRunBase = kUncodedFan + 1;         // 6 pairs of end codes × 4 run shapes
 constexpr int kPairBase = kRunBase + 24;          // two candidates between a 1 and a 2: 3 × 3
-static_assert(kPairBase + 9 == 66);
 
 // A vertex's edges, counted up to 16: enough to compare two valences, and
 // a hub's long list is not walked at every split of its neighbours.
@@ -399,6 +398,7 @@ int cappedValence(const SimplexStore& store, uint32_t vertex) {
 // fan neighbours' codes, by whether the edge is in three or more
 // triangles, and by whether v and v2 are joined.
 int VertexSplitter::runClass(const Entry& edge, int cutEdges, bool mirrored) {
+  static_assert(kPairBase + 9 == kRunClasses);
   if (fanSize_ == 0) {
     const size_t e = size_t(&edge - star_.data()) - begin_[1];
     const bool crowdedEdge = crowdedFans_ && fanStart_[e + 1] - fanStart_[e] > 2;
@@ -461,8 +461,9 @@ int VertexSplitter::runClass(const Entry& edge, int cutEdges, bool mirrored) {
 // edge collapse, nearly always; one whose edges are in three or more
 // triangles is that of two vertices that met in a cell without an edge
 // between them, the more often the more such edges (classes by the extra
-// fan neighbours, 0..4 and more); and cells of two vertices apart
-// (triceratops −0.146 bits per vertex, fandisk −0.067, bunny −0.034).
+// fan neighbours, 0..4 and more); and whether the cell held two vertices
+// (against one model: triceratops −0.200 bits per vertex, fandisk −0.088,
+// bunny −0.034).
 int VertexSplitter::vertexClass(int balance) const {
   const int shape = fanSize_ > 0 ? 0 : !crowdedFans_ ? 1 : 1 + std::min(crowdedLinks_, 4);
   return shape * 2 + (balance == 1);

@@ -21,10 +21,11 @@
 // At geometric levels the split is known to separate V1 and V2 along the
 // split axis, so edges and triangles are coded by where their other
 // vertices lie against the split plane, and edges also by the codes already
-// given to their fan neighbours (docs/FORMAT.md). In a tetrahedral star the
-// cut edges form the link of the new edge v v2, a cycle: each has two
-// triangles coded 4, which makes the triangles between cut edges cheap
-// when the most constrained of them are taken first.
+// given around the vertex's fan (runClass() in vertex_split.cpp;
+// docs/FORMAT.md), the vertex's own code by the star's shape. In a
+// tetrahedral star the cut edges form the link of the new edge v v2, a
+// cycle: each has two triangles coded 4, which makes the triangles between
+// cut edges cheap when the most constrained of them are taken first.
 //
 // Triangles and tetrahedra are oriented. A child that inherits its parent's
 // tuple keeps the parent's orientation; the second copy of a code-3 simplex
@@ -224,8 +225,9 @@ class VertexSplitter {
   // dragon −0.083).
   static constexpr int kCutStates = 5;
   BitModel edgeModels_[kCutStates][8][kEdgeClasses][2][3];
-  // Edges by direction class alone, mixed with the above (weights per cut
-  // state but the last two share one).
+  // Edges by direction class alone, mixed with the above (weight vectors
+  // by cut state, the last two sharing one, and by whether the star is one
+  // closed fan).
   BitModel edgeDirectionModels_[kEdgeClasses][2][3];
   // Edges of surface stars by splitBalance() and direction class, mixed in
   // third (with learned priors: dragon −0.114 bits per vertex, bunny
@@ -245,7 +247,7 @@ class VertexSplitter {
   int crowdedLinks_ = 0;
   int fanSize_ = 0;  // edges around the closed fan, 0 if the star is not one
   std::vector<uint32_t> fanOrder_;
-  int firstCut_ = -1;     // fan position of the first edge coded 3 or 4
+  int firstCut_ = -1;     // fan position of the first edge coded 4
   double halfWidth_ = 0;  // of the split cell along the split axis (0: not geometric)
   // Orientation models: [dimension - 2][copy or new][vote class][face of higher].
   BitModel orientationModels_[2][2][3][2];
