@@ -1,6 +1,8 @@
 #include "model_priors.h"
 
 #include <algorithm>
+#include <cstdint>
+#include <cstdlib>
 #include <iterator>
 
 #include "mixer.h"
@@ -72,11 +74,13 @@ constexpr CodedFamily codedFamily(const uint8_t (&coded)[kCoded]) {
 // that writing compiled priors back gives the same codes.
 uint8_t priorCode(uint32_t probabilityOfZero) {
   uint8_t best = 1;
-  for (int code = 2; code <= 255; ++code) {
-    const auto distance = [probabilityOfZero](int c) {
-      return std::abs(int(priorOfCode(uint8_t(c))) - int(probabilityOfZero));
-    };
-    if (distance(code) < distance(best)) best = uint8_t(code);
+  int bestDistance = INT32_MAX;
+  for (int code = 1; code <= 255; ++code) {
+    const int distance = std::abs(int(priorOfCode(uint8_t(code))) - int(probabilityOfZero));
+    if (distance < bestDistance) {
+      best = uint8_t(code);
+      bestDistance = distance;
+    }
   }
   return best;
 }

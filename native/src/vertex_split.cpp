@@ -300,7 +300,6 @@ void VertexSplitter::linkFans() {
     star_[i].pairedTriangles = 0;
     star_[i].links[0] = star_[i].links[1] = kNoSimplex;
   }
-  crowdedFans_ = false;
   crowdedLinks_ = 0;
   auto link = [this](uint32_t from, uint32_t to) {
     uint32_t* links = star_[from].links;
@@ -309,7 +308,6 @@ void VertexSplitter::linkFans() {
     } else if (links[1] == kNoSimplex) {
       links[1] = to;
     } else {
-      crowdedFans_ = true;
       ++crowdedLinks_;
     }
   };
@@ -325,7 +323,7 @@ void VertexSplitter::linkFans() {
   }
   // Most stars (those of surfaces) have no edge in more than two
   // triangles: their links list every fan neighbour already.
-  if (!crowdedFans_) {
+  if (!crowdedFans()) {
     indexFan();
     return;
   }
@@ -401,7 +399,7 @@ int VertexSplitter::runClass(const Entry& edge, int cutEdges, bool mirrored) {
   static_assert(kPairBase + 9 == kRunClasses);
   if (fanSize_ == 0) {
     const size_t e = size_t(&edge - star_.data()) - begin_[1];
-    const bool crowdedEdge = crowdedFans_ && fanStart_[e + 1] - fanStart_[e] > 2;
+    const bool crowdedEdge = crowdedFans() && fanStart_[e + 1] - fanStart_[e] > 2;
     return mirrorSet(edge.fanCodes, mirrored) + 8 * crowdedEdge + 16 * (star_[0].code == 4);
   }
   // The code (0: 1, 1: 2, 2: cut) and distance of the nearest coded edge
@@ -465,7 +463,7 @@ int VertexSplitter::runClass(const Entry& edge, int cutEdges, bool mirrored) {
 // (against one model: triceratops −0.200 bits per vertex, fandisk −0.088,
 // bunny −0.034).
 int VertexSplitter::vertexClass(int balance) const {
-  const int shape = fanSize_ > 0 ? 0 : !crowdedFans_ ? 1 : 1 + std::min(crowdedLinks_, 4);
+  const int shape = fanSize_ > 0 ? 0 : 1 + std::min(crowdedLinks_, 4);
   return shape * 2 + (balance == 1);
 }
 

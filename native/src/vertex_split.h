@@ -192,10 +192,12 @@ class VertexSplitter {
   std::vector<Entry> star_;
   std::vector<double> cosines_, lengths_;  // per edge of the star
   std::vector<uint32_t> codingOrder_;  // star_ indices in the order codes are taken
-  // When some edge of the star has more than two fan neighbours (its links
-  // hold two), the fan neighbours of every edge (star_ indices): those of
-  // the edge begin_[1] + e are fanList_[fanStart_[e] .. fanStart_[e + 1]).
-  bool crowdedFans_ = false;
+  // Fan neighbours beyond two per edge, summed over the star's edges (links
+  // hold two). When there are any, the fan neighbours of every edge
+  // (star_ indices): those of the edge begin_[1] + e are
+  // fanList_[fanStart_[e] .. fanStart_[e + 1]).
+  int crowdedLinks_ = 0;
+  bool crowdedFans() const { return crowdedLinks_ > 0; }
   std::vector<uint32_t> fanStart_, fanList_, fanFill_;
   std::array<size_t, 5> begin_{};  // star_ entries of dimension d: [begin_[d], begin_[d+1])
   // Simplices of dimension d at v or v2 after the split, gathered on the
@@ -242,9 +244,8 @@ class VertexSplitter {
   // Edges by where they lie in the star's fan (runClass()), mixed in fourth.
   static constexpr int kRunClasses = 66, kCutBands = 5;
   BitModel edgeRunModels_[kCutBands * kRunClasses][2][3];
-  // The star's shape (linkFans): extra fan neighbours beyond two per edge,
-  // and, when its edges form one closed fan, their order around it.
-  int crowdedLinks_ = 0;
+  // When the star's edges form one closed fan (linkFans), their order
+  // around it.
   int fanSize_ = 0;  // edges around the closed fan, 0 if the star is not one
   std::vector<uint32_t> fanOrder_;
   int firstCut_ = -1;     // fan position of the first edge coded 4
@@ -336,7 +337,7 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int
       if (entry.code == 4 && cutEdges == 0) firstCut_ = entry.fanIndex;
       cutEdges += entry.code == 4;
       const uint8_t bit = uint8_t(1u << std::min(entry.code - 1, 2));
-      if (crowdedFans_) {
+      if (crowdedFans()) {
         const size_t edge = index - begin_[1];
         for (uint32_t k = fanStart_[edge]; k < fanStart_[edge + 1]; ++k) star_[fanList_[k]].fanCodes |= bit;
       } else {

@@ -1,4 +1,5 @@
-// The logistic mixer of the one-vertex split predictions.
+// The logistic mixer of the predictions, and the one-byte priors that
+// share its logistic functions.
 #include <gtest/gtest.h>
 
 #include <array>
@@ -29,25 +30,6 @@ TEST(Logistic, SquashIsMonotoneAndStretchInvertsIt) {
 
 // Bits that are 0 nine times in ten: an input model that knows it and one
 // stuck at 1/2. The mixer must learn to follow the first.
-// Priors are stored as one-byte logits (model_priors.h): 1/2 exactly at the
-// middle code, monotone, and writing a prior back gives a code of the same
-// probability, so retraining one family leaves the others as they were.
-TEST(ModelPriors, OneByteCodesRoundTrip) {
-  EXPECT_EQ(priorOfCode(kHalfPriorCode), kProbabilityOne / 2);
-  EXPECT_EQ(priorCode(kProbabilityOne / 2), kHalfPriorCode);
-  for (int code = 1; code <= 255; ++code) {
-    const uint16_t prior = priorOfCode(uint8_t(code));
-    EXPECT_GE(prior, 31u);
-    EXPECT_LE(prior, kProbabilityOne - 31);
-    if (code > 1) EXPECT_GE(prior, priorOfCode(uint8_t(code - 1)));
-    EXPECT_EQ(priorOfCode(priorCode(prior)), prior);
-  }
-  // Near certainty (models stop at 1 − 31/2^15, 99.9 %) the codes still
-  // tell 99 % from 99.9 %.
-  EXPECT_LT(priorOfCode(priorCode(uint32_t(kProbabilityOne * 0.99))), uint32_t(kProbabilityOne * 0.995));
-  EXPECT_GT(priorOfCode(priorCode(uint32_t(kProbabilityOne * 0.999))), uint32_t(kProbabilityOne * 0.995));
-}
-
 TEST(Mixer, LearnsToTrustTheInformativeInput) {
   BitModel informed, uninformed;
   informed.fast = informed.slow = uint16_t(0.9 * kProbabilityOne);
@@ -83,6 +65,27 @@ TEST(Mixer, StartsFromGivenWeightsAndCountsUses) {
   EXPECT_EQ(mixer.uses()[0], 1u);
   EXPECT_EQ(mixer.uses()[1], 2u);
   EXPECT_EQ(mixer.uses()[2], 0u);
+}
+
+// Priors are stored as one-byte logits (model_priors.h): 1/2 exactly at the
+// middle code, monotone, and writing a prior back gives a code of the same
+// probability, so retraining one family leaves the others as they were.
+TEST(ModelPriors, OneByteCodesRoundTrip) {
+  EXPECT_EQ(priorOfCode(kHalfPriorCode), kProbabilityOne / 2);
+  EXPECT_EQ(priorCode(kProbabilityOne / 2), kHalfPriorCode);
+  for (int code = 1; code <= 255; ++code) {
+    const uint16_t prior = priorOfCode(uint8_t(code));
+    EXPECT_GE(prior, 31u);
+    EXPECT_LE(prior, kProbabilityOne - 31);
+    if (code > 1) {
+      EXPECT_GE(prior, priorOfCode(uint8_t(code - 1)));
+    }
+    EXPECT_EQ(priorOfCode(priorCode(prior)), prior);
+  }
+  // Near certainty (models stop at 1 − 31/2^15, 99.9 %) the codes still
+  // tell 99 % from 99.9 %.
+  EXPECT_LT(priorOfCode(priorCode(uint32_t(kProbabilityOne * 0.99))), uint32_t(kProbabilityOne * 0.995));
+  EXPECT_GT(priorOfCode(priorCode(uint32_t(kProbabilityOne * 0.999))), uint32_t(kProbabilityOne * 0.995));
 }
 
 // A coder that keeps the probability it was given.
