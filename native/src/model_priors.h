@@ -68,7 +68,7 @@ constexpr uint16_t kPriorObservations = 24;
 enum class MixerFamily { OneVertexSplits, CellCounts, OneVertexByParallelogram, OneVertexByPlaneAndCentroid, EdgeCodes };
 constexpr int kMixerFamilies = 5;
 constexpr std::array<size_t, kMixerFamilies> kMixerSets = {45, 39, 12, 60, 8};
-constexpr std::array<size_t, kMixerFamilies> kMixerInputs = {4, 3, 4, 4, 4};
+constexpr std::array<size_t, kMixerFamilies> kMixerInputs = {5, 3, 5, 5, 4};
 // The starting weights of a mixer family: kMixerSets × kMixerInputs values,
 // weight vector by weight vector, in units of 2^-16.
 const int32_t* mixerPriors(MixerFamily family);

@@ -141,6 +141,21 @@ void medianAndDeviation(double* values, uint32_t count, double& median, double& 
 
 namespace {
 
+// The odds that the vertex lies in the upper half (after mirroring) by
+// its parallelograms' median offset t and deviation s, in half widths, as
+// a logistic of t / sqrt(s² + q): q stands for the error of the
+// neighbours' own cells, which the deviation does not see when the
+// predictions agree. The models bucket t and s; this input, unbucketed,
+// lets the mixers weigh how far apart within a bucket they are (bunny
+// −0.041 bits per vertex, triceratops −0.059, fandisk −0.071; scale and q
+// tuned on these three: ±0.01 around them).
+uint16_t parallelogramOdds(const double offset, const double spread) {
+  constexpr double kVariance = 0.15, kScale = 700;  // squared half widths; logistic units of 1/256
+  const double logit = std::clamp(kScale * offset / std::sqrt(spread + kVariance), -2047.0, 2047.0);
+  const uint32_t p0 = uint32_t(Logistic::squash(int(std::lround(logit)))) << 3;
+  return uint16_t(std::clamp<uint32_t>(p0, 64, kProbabilityOne - 64));
+}
+
 int centroidBucket(double t) {
   static constexpr double kBounds[kCentroidBuckets - 1] = {-2, -1, -0.5, -0.25, 0, 0.25, 0.5, 1, 2};
   return countAtMost(t, kBounds);
@@ -170,11 +185,11 @@ PositionPredictor::PositionPredictor(const SplitSchedule& schedule, const Simple
                 kFamilySize[int(ModelFamily::OneVertexByParallelogram)]);
   static_assert(size_t(kElongationGroups) * kScaleClasses * kAgreementClasses ==
                     kMixerSets[int(MixerFamily::OneVertexSplits)] &&
-                kMixerInputs[int(MixerFamily::OneVertexSplits)] == 4);
+                kMixerInputs[int(MixerFamily::OneVertexSplits)] == kSingleInputs);
   static_assert(kParallelogramBuckets == kMixerSets[int(MixerFamily::OneVertexByParallelogram)] &&
-                kMixerInputs[int(MixerFamily::OneVertexByParallelogram)] == 4);
+                kMixerInputs[int(MixerFamily::OneVertexByParallelogram)] == kSingleInputs);
   static_assert(kCentroidBuckets * kPlaneBuckets == kMixerSets[int(MixerFamily::OneVertexByPlaneAndCentroid)] &&
-                kMixerInputs[int(MixerFamily::OneVertexByPlaneAndCentroid)] == 4);
+                kMixerInputs[int(MixerFamily::OneVertexByPlaneAndCentroid)] == kSingleInputs);
   primeModels(ModelFamily::OneVertexSplits, models_.data());
   primeModels(ModelFamily::OneVertexByPlane, planeModels_.data());
   primeModels(ModelFamily::OneVertexByCentroid, centroidModels_.data());
@@ -361,6 +376,8 @@ bool PositionPredictor::contextsOf(uint32_t vertex, int level, SingleContexts& c
   c.parallelogram =
       (plane * kSpreadClasses + spreadClass(f.parallelogramSpread)) * kParallelogramBuckets + f.parallelogram;
   parallelogramPredictions_ += f.hasParallelogram;
+  c.parallelogramOdds.fast = c.parallelogramOdds.slow =
+      f.hasParallelogram ? parallelogramOdds(f.parallelogramOffset, f.parallelogramSpread) : kProbabilityOne / 2;
   return true;
 }
 

@@ -38,8 +38,10 @@
 //     −0.26 and −0.25 on the first three).
 // The configuration is mirrored so that the prediction points to the upper
 // half, which lets the two mirror images share statistics. A one-vertex split
-// mixes four models chosen by these features (mixer.h); the split of a cell
-// of several vertices gets a class for CountCoder.
+// mixes four models chosen by these features (mixer.h) and, as a fifth
+// input, the odds of the upper half computed from the parallelograms' median
+// offset over their deviation, unbucketed; the split of a cell of several
+// vertices gets a class for CountCoder.
 #pragma once
 
 #include <algorithm>
@@ -83,6 +85,10 @@ void medianAndDeviation(double* values, uint32_t count, double& median, double& 
 
 class PositionPredictor {
  public:
+  // Inputs of the one-vertex mixers: the four models and the parallelogram
+  // odds.
+  static constexpr int kSingleInputs = 5;
+
   // `store`: the complex the predictions read, as it changes.
   PositionPredictor(const SplitSchedule& schedule, const SimplexStore& store);
 
@@ -113,10 +119,10 @@ class PositionPredictor {
       first = counts.codeSingle(coder, level, parentOneSided, inFirstHalf);
     } else {
       const bool bit = codeWithMixers(
-          coder, std::array<Mixer<4>*, 3>{&mixer_, &parallelogramMixer_, &planeAndCentroidMixer_},
+          coder, std::array<Mixer<kSingleInputs>*, 3>{&mixer_, &parallelogramMixer_, &planeAndCentroidMixer_},
           {c.mixerSet, c.parallelogramMixerSet, c.planeAndCentroidMixerSet},
           {&models_[size_t(c.joint)], &planeModels_[size_t(c.plane)], &centroidModels_[size_t(c.centroid)],
-           &parallelogramModels_[size_t(c.parallelogram)]},
+           &parallelogramModels_[size_t(c.parallelogram)], &c.parallelogramOdds},
           inFirstHalf != c.mirrored);
       first = bit != c.mirrored;
     }
@@ -147,7 +153,7 @@ class PositionPredictor {
   const std::vector<BitModel>& centroidModels() const { return centroidModels_; }
   const std::vector<BitModel>& parallelogramModels() const { return parallelogramModels_; }
   // One of the three mixers of one-vertex splits.
-  const Mixer<4>& mixer(MixerFamily family) const {
+  const Mixer<kSingleInputs>& mixer(MixerFamily family) const {
     return family == MixerFamily::OneVertexByParallelogram      ? parallelogramMixer_
            : family == MixerFamily::OneVertexByPlaneAndCentroid ? planeAndCentroidMixer_
                                                                 : mixer_;
@@ -218,6 +224,10 @@ class PositionPredictor {
     int joint, plane, centroid, parallelogram;
     int mixerSet, parallelogramMixerSet, planeAndCentroidMixerSet;
     bool mirrored;
+    // Holds, for this bit alone, the odds of the upper half that the
+    // parallelogram predictions give (parallelogramOdds() in
+    // position_predictor.cpp); its update after the bit is discarded.
+    BitModel parallelogramOdds;
   };
   bool contextsOf(uint32_t vertex, int level, SingleContexts& contexts);
   // The neighbourhood class of a cell's count from the plane or centroid.
@@ -240,7 +250,7 @@ class PositionPredictor {
   // The parallelogram predictions of one gather(), and their deviations.
   std::vector<double> predictions_;
   std::vector<BitModel> models_, planeModels_, centroidModels_, parallelogramModels_;
-  Mixer<4> mixer_, parallelogramMixer_, planeAndCentroidMixer_;
+  Mixer<kSingleInputs> mixer_, parallelogramMixer_, planeAndCentroidMixer_;
   uint64_t countPredictions_ = 0;
   uint64_t positionPredictions_ = 0;
   uint64_t parallelogramPredictions_ = 0;
