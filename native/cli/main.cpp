@@ -253,10 +253,10 @@ int runInfo(const std::string& input, bool json) {
     std::printf("  \"predictions\": {\"edgeCodesByDirection\": %" PRIu64 ", \"countPredictions\": %" PRIu64
                 ", \"positionPredictions\": %" PRIu64 ", \"parallelogramPredictions\": %" PRIu64
                 ", \"pairedTriangles\": %" PRIu64 ", \"closedFanEdgeCodes\": %" PRIu64
-                ", \"cutCandidatePairs\": %" PRIu64 "},\n",
+                ", \"cutCandidatePairs\": %" PRIu64 ", \"refinedNeighbourPredictions\": %" PRIu64 "},\n",
                 stats.edgeCodesByDirection, stats.countPredictions, stats.positionPredictions,
                 stats.parallelogramPredictions, stats.pairedTriangles, stats.closedFanEdgeCodes,
-                stats.cutCandidatePairs);
+                stats.cutCandidatePairs, stats.refinedNeighbourPredictions);
     std::printf("  \"chunks\": [");
     const auto& chunks = decoder.chunks();
     for (size_t i = 0; i < chunks.size(); ++i)
@@ -299,11 +299,12 @@ int runInfo(const std::string& input, bool json) {
                 stats.orientationMispredicted);
     std::printf("predictions     %" PRIu64 " edge codes by split direction, %" PRIu64
                 " cell counts and %" PRIu64 " one-vertex splits from the neighbourhood (%" PRIu64
-                " of them with parallelograms), %" PRIu64 " triangles by pairing, %" PRIu64
-                " edge codes by their run around a closed fan (%" PRIu64 " of two cut candidates)\n",
+                " of them with parallelograms, %" PRIu64 " with neighbours split at the level already), %" PRIu64
+                " triangles by pairing, %" PRIu64 " edge codes by their run around a closed fan (%" PRIu64
+                " of two cut candidates)\n",
                 stats.edgeCodesByDirection, stats.countPredictions, stats.positionPredictions,
-                stats.parallelogramPredictions, stats.pairedTriangles, stats.closedFanEdgeCodes,
-                stats.cutCandidatePairs);
+                stats.parallelogramPredictions, stats.refinedNeighbourPredictions, stats.pairedTriangles,
+                stats.closedFanEdgeCodes, stats.cutCandidatePairs);
   }
   std::printf("chunks          %zu\n", decoder.chunks().size());
   std::printf("  %5s %10s %8s %10s\n", "chunk", "offset", "payload", "splits");

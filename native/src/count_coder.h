@@ -14,7 +14,9 @@
 //     Populations above 15 share one neighbourhood model per class and tree
 //     node: few cells are that large (bunny −0.06 bits per vertex; −0.05
 //     with a row per bit width of the population, which learns more
-//     slowly).
+//     slowly),
+//   - and by where the neighbours already refined at this level lie
+//     (PositionPredictor::refinementClass), a fourth model mixed in.
 // After six decisions the few remaining candidates of a large cell are nearly
 // equiprobable and are coded uniformly.
 #pragma once
@@ -44,6 +46,10 @@ struct CountContext {
   // (PositionPredictor), kParallelogramBuckets - 1 for nowhere.
   static constexpr int kParallelogramBuckets = 12;
   int parallelogram = kParallelogramBuckets - 1;
+  // Where the neighbours that have split at this level already lie
+  // (PositionPredictor::refinementClass), 0..kRefinementClasses-1.
+  static constexpr int kRefinementClasses = 256;
+  int refinement = 0;
 };
 
 class CountCoder {
@@ -57,7 +63,7 @@ class CountCoder {
         mixer_(CountContext::kElongationGroups * kNeighbourhoodClasses, mixerPriors(MixerFamily::CellCounts)) {
     static_assert(size_t(CountContext::kElongationGroups) * kNeighbourhoodClasses ==
                       kMixerSets[int(MixerFamily::CellCounts)] &&
-                  kMixerInputs[int(MixerFamily::CellCounts)] == 3);
+                  kMixerInputs[int(MixerFamily::CellCounts)] == 4);
     models_.resize(size_t(levels_) * kParentClasses * kContextsPerLevel);
     static_assert(size_t(kNeighbourhoodClasses) * kNeighbourhoodNodes == kFamilySize[int(ModelFamily::CellCounts)]);
     if (neighbourhoods) {
@@ -67,12 +73,17 @@ class CountCoder {
                     kFamilySize[int(ModelFamily::CellCountsByParallelogram)]);
       parallelogramModels_.resize(kFamilySize[int(ModelFamily::CellCountsByParallelogram)]);
       primeModels(ModelFamily::CellCountsByParallelogram, parallelogramModels_.data());
+      static_assert(size_t(CountContext::kRefinementClasses) * kPopulationGroups * kRefinementNodes ==
+                    kFamilySize[int(ModelFamily::CellCountsByRefinement)]);
+      refinementModels_.resize(kFamilySize[int(ModelFamily::CellCountsByRefinement)]);
+      primeModels(ModelFamily::CellCountsByRefinement, refinementModels_.data());
     }
   }
 
   const std::vector<BitModel>& neighbourhoodModels() const { return neighbourhoodModels_; }
   const std::vector<BitModel>& parallelogramModels() const { return parallelogramModels_; }
-  const Mixer<3>& mixer() const { return mixer_; }
+  const std::vector<BitModel>& refinementModels() const { return refinementModels_; }
+  const Mixer<4>& mixer() const { return mixer_; }
 
   // The count of a one-vertex cell, 1 when the vertex is in the first half;
   // the same model as code() with population 1, in a loop-free form.
@@ -117,6 +128,13 @@ class CountCoder {
                                            context.parallelogram) *
                                     kParallelogramNodes]
             : nullptr;
+    // And with the model of where the neighbours already refined at this
+    // level lie, by population group and tree node (the root, the two of
+    // the second decision, then one).
+    BitModel* byRefinement =
+        neighbourhoodClass > 0
+            ? &refinementModels_[size_t(context.refinement * kPopulationGroups + populationGroup) * kRefinementNodes]
+            : nullptr;
     uint32_t low = 0, candidates = population + 1, node = 1;
     while (candidates > 1) {
       if (node >= kTreeNodes)
@@ -126,7 +144,8 @@ class CountCoder {
       if (byNeighbourhood)
         upper = mixer_.code(coder, context.elongation * kNeighbourhoodClasses + neighbourhoodClass,
                             {&byNeighbourhood[node], &models[node],
-                             &byParallelogram[std::min(node, kParallelogramNodes - 1)]},
+                             &byParallelogram[std::min(node, kParallelogramNodes - 1)],
+                             &byRefinement[std::min(node, kRefinementNodes - 1)]},
                             upper);
       else
         upper = coder.bit(models[node], upper);
@@ -151,6 +170,7 @@ class CountCoder {
   static constexpr uint32_t kNeighbourhoodNodes = kSmallNodes + kTreeNodes;
   static constexpr int kPopulationGroups = 4;
   static constexpr uint32_t kParallelogramNodes = 16;
+  static constexpr uint32_t kRefinementNodes = 4;
 
   static uint32_t populationOffset(uint32_t p) {
     if (p <= kExactPopulations) {
@@ -166,8 +186,8 @@ class CountCoder {
   }
 
   int levels_;
-  std::vector<BitModel> models_, neighbourhoodModels_, parallelogramModels_;
-  Mixer<3> mixer_;
+  std::vector<BitModel> models_, neighbourhoodModels_, parallelogramModels_, refinementModels_;
+  Mixer<4> mixer_;
 };
 
 }  // namespace kdmesh

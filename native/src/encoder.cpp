@@ -326,8 +326,10 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
     keep(ModelFamily::OneVertexByPlane, predictor.planeModels().data());
     keep(ModelFamily::OneVertexByCentroid, predictor.centroidModels().data());
     keep(ModelFamily::OneVertexByParallelogram, predictor.parallelogramModels().data());
+    keep(ModelFamily::OneVertexByRefinement, predictor.refinementModels().data());
     keep(ModelFamily::CellCounts, counts.neighbourhoodModels().data());
     keep(ModelFamily::CellCountsByParallelogram, counts.parallelogramModels().data());
+    keep(ModelFamily::CellCountsByRefinement, counts.refinementModels().data());
     keep(ModelFamily::EdgeCodes, splitter.edgeModels());
     keep(ModelFamily::EdgeCodesByDirection, splitter.edgeDirectionModels());
     keep(ModelFamily::EdgeCodesByBalance, splitter.edgeBalanceModels());

@@ -14,8 +14,9 @@ namespace {
 // kOneVertexByPlanePriors, kOneVertexByCentroidPriors,
 // kEdgeCodeByDirectionPriors, kTriangleCodePriors,
 // kOneVertexByParallelogramPriors, kCellCountByParallelogramPriors,
-// kEdgeCodeByBalancePriors, kEdgeCodeByRunPriors, kVertexCodePriors: P(bit ==
-// 0) as priorCode(), one byte per model, run-length coded (model_priors.h);
+// kEdgeCodeByBalancePriors, kEdgeCodeByRunPriors, kVertexCodePriors,
+// kOneVertexByRefinementPriors, kCellCountByRefinementPriors: P(bit == 0) as
+// priorCode(), one byte per model, run-length coded (model_priors.h);
 // kOneVertexMixerPriors, kCellCountMixerPriors,
 // kOneVertexByParallelogramMixerPriors,
 // kOneVertexByPlaneAndCentroidMixerPriors, kEdgeCodeMixerPriors: starting
@@ -105,7 +106,8 @@ void primeModels(ModelFamily family, BitModel* models) {
       codedFamily(kOneVertexByCentroidPriors), codedFamily(kEdgeCodeByDirectionPriors),
       codedFamily(kTriangleCodePriors),        codedFamily(kOneVertexByParallelogramPriors),
       codedFamily(kCellCountByParallelogramPriors), codedFamily(kEdgeCodeByBalancePriors),
-      codedFamily(kEdgeCodeByRunPriors), codedFamily(kVertexCodePriors)};
+      codedFamily(kEdgeCodeByRunPriors), codedFamily(kVertexCodePriors),
+      codedFamily(kOneVertexByRefinementPriors), codedFamily(kCellCountByRefinementPriors)};
   const CodedFamily& coded = kPriors[int(family)];
   auto prime = [&models](uint16_t prior) {
     models->fast = models->slow = prior;

@@ -32,9 +32,12 @@ enum class ModelFamily {
   EdgeCodesByBalance,
   EdgeCodesByRun,
   VertexCodes,
+  OneVertexByRefinement,
+  CellCountsByRefinement,
 };
-constexpr int kModelFamilies = 12;
-constexpr std::array<size_t, kModelFamilies> kFamilySize = {9000, 11760, 3042, 300, 250, 294, 864, 648, 768, 2646, 1980, 36};
+constexpr int kModelFamilies = 14;
+constexpr std::array<size_t, kModelFamilies> kFamilySize = {9000, 11760, 3042, 300, 250, 294, 864,
+                                                            648,  768,   2646, 1980, 36, 512, 4096};
 
 // model_priors.inc holds each family run-length coded: half the models of
 // the large families were never used in training and start at 1/2; a run of
@@ -68,7 +71,7 @@ constexpr uint16_t kPriorObservations = 24;
 enum class MixerFamily { OneVertexSplits, CellCounts, OneVertexByParallelogram, OneVertexByPlaneAndCentroid, EdgeCodes };
 constexpr int kMixerFamilies = 5;
 constexpr std::array<size_t, kMixerFamilies> kMixerSets = {45, 39, 12, 60, 8};
-constexpr std::array<size_t, kMixerFamilies> kMixerInputs = {5, 3, 5, 5, 4};
+constexpr std::array<size_t, kMixerFamilies> kMixerInputs = {6, 4, 6, 6, 4};
 // The starting weights of a mixer family: kMixerSets × kMixerInputs values,
 // weight vector by weight vector, in units of 2^-16.
 const int32_t* mixerPriors(MixerFamily family);

@@ -81,6 +81,29 @@ int spreadClass(double spread) {
   return countAtMost(spread, kBounds);
 }
 
+// Where a neighbour lies along the split axis, from its offset from the
+// cell's centre in half widths of the cell: cells of this level lie 2
+// apart, and one that has split at this level already 0.5 off that grid,
+// in its lower or upper half. Bin 3 · (slab + 1) + (side + 1) for the
+// slabs −1, 0 and 1 (the cell's own and the two beside it) and the sides
+// −1 (lower half), 0 (not split yet) and 1; bin 9 for slabs farther off.
+// Offsets are exact (multiples of 1/4 grid steps) and twice one is an
+// integer of magnitude below 2^33, so integers place it: the quarter
+// 4 · slab + side. Biased to be positive, its shift and mask are a floor
+// and a modulo.
+}  // namespace
+
+int alongBin(double offset) {
+  constexpr int64_t kBias = int64_t(1) << 36;
+  const uint64_t quarters = uint64_t(int64_t(offset * 2) + kBias);
+  static constexpr int kSide[4] = {0, 1, 0, -1};
+  const int64_t slab = int64_t((quarters + 1) >> 2) - kBias / 4;
+  const int64_t bin = 3 * (slab + 1) + kSide[quarters & 3] + 1;
+  return uint64_t(slab + 1) <= 2 ? int(bin) : 9;
+}
+
+namespace {
+
 // The median of `count` sorted values: the middle one, or the mean of the
 // two middle ones.
 double middleOf(const double* sorted, uint32_t count) {
@@ -171,6 +194,7 @@ PositionPredictor::PositionPredictor(const SplitSchedule& schedule, const Simple
       planeModels_(size_t(kOutsideClasses) * kScaleClasses * kTiltClasses * kPlaneBuckets),
       centroidModels_(size_t(kValenceClasses) * kScaleClasses * kCentroidBuckets),
       parallelogramModels_(size_t(kPlaneBuckets) * kSpreadClasses * kParallelogramBuckets),
+      refinementModels_(size_t(CountContext::kRefinementClasses) * 2),
       mixer_(kElongationGroups * kScaleClasses * kAgreementClasses, mixerPriors(MixerFamily::OneVertexSplits)),
       parallelogramMixer_(kParallelogramBuckets, mixerPriors(MixerFamily::OneVertexByParallelogram)),
       planeAndCentroidMixer_(kCentroidBuckets * kPlaneBuckets, mixerPriors(MixerFamily::OneVertexByPlaneAndCentroid)) {
@@ -194,6 +218,8 @@ PositionPredictor::PositionPredictor(const SplitSchedule& schedule, const Simple
   primeModels(ModelFamily::OneVertexByPlane, planeModels_.data());
   primeModels(ModelFamily::OneVertexByCentroid, centroidModels_.data());
   primeModels(ModelFamily::OneVertexByParallelogram, parallelogramModels_.data());
+  static_assert(size_t(CountContext::kRefinementClasses) * 2 == kFamilySize[int(ModelFamily::OneVertexByRefinement)]);
+  primeModels(ModelFamily::OneVertexByRefinement, refinementModels_.data());
   widths_.resize(size_t(schedule.levels) + 1);
   for (size_t level = 0; level < widths_.size(); ++level)
     for (int a = 0; a < 3; ++a)
@@ -271,8 +297,11 @@ void PositionPredictor::forgetAcross(uint32_t triangle, uint32_t position) {
 // The incidence lists are walked where they are. A snapshot of them in
 // contiguous rows, rebuilt twice per level, took more instructions (bunny
 // decode 1.156 G against 1.135 G) and 24 bytes per triangle more memory.
-bool PositionPredictor::gather(uint32_t vertex, int axis, Neighbourhood& around) {
+bool PositionPredictor::gather(uint32_t vertex, int level, Neighbourhood& around) {
   if (vertex >= store_.vertexCapacity() || vertex >= places_.size()) return false;
+  const int axis = axis_[size_t(level)];
+  const double inverseHalfWidth = inverseHalfWidths_[size_t(level)];
+  std::array<uint32_t, 10> alongAxis{};
   // Scalars rather than arrays: these loops, the decoder's hottest, stalled
   // on store-to-load forwarding with array temporaries.
   const double* at = places_[vertex].centre;
@@ -294,6 +323,7 @@ bool PositionPredictor::gather(uint32_t vertex, int axis, Neighbourhood& around)
     const double ax = a[0] - atX, ay = a[1] - atY, az = a[2] - atZ;
     const double bx = b[0] - atX, by = b[1] - atY, bz = b[2] - atZ;
     const double aAlong = a[axis] - atAxis;
+    ++alongAxis[size_t(alongBin(aAlong * inverseHalfWidth))];
     sumX += ax;
     sumY += ay;
     sumZ += az;
@@ -318,7 +348,7 @@ bool PositionPredictor::gather(uint32_t vertex, int axis, Neighbourhood& around)
     double median = 0, deviation = 0;
     if (parallelograms > 0) medianAndDeviation(predictions, parallelograms, median, deviation);
     around = {{sumX, sumY, sumZ}, {normalX, normalY, normalZ}, squared, along, median, deviation, count,
-              parallelograms, true};
+              parallelograms, true, alongAxis};
     return true;
   }
   // No triangle: the other ends of the edges.
@@ -333,6 +363,7 @@ bool PositionPredictor::gather(uint32_t vertex, int axis, Neighbourhood& around)
     squared += y * y;
     squared += z * z;
     along += (centre[axis] - atAxis) * (centre[axis] - atAxis);
+    ++alongAxis[size_t(alongBin((centre[axis] - atAxis) * inverseHalfWidth))];
     const double crossX = previousY * z - previousZ * y;
     const double crossY = previousZ * x - previousX * z;
     const double crossZ = previousX * y - previousY * x;
@@ -347,13 +378,13 @@ bool PositionPredictor::gather(uint32_t vertex, int axis, Neighbourhood& around)
     ++count;
   });
   if (count == 0) return false;
-  around = {{sumX, sumY, sumZ}, {normalX, normalY, normalZ}, squared, along, 0, 0, count, 0, false};
+  around = {{sumX, sumY, sumZ}, {normalX, normalY, normalZ}, squared, along, 0, 0, count, 0, false, alongAxis};
   return true;
 }
 
 bool PositionPredictor::contextsOf(uint32_t vertex, int level, SingleContexts& c) {
   Neighbourhood around;
-  if (!gather(vertex, axis_[size_t(level)], around)) return false;
+  if (!gather(vertex, level, around)) return false;
   ++positionPredictions_;
   const Features f = features(around, level);
   c.mirrored = f.mirrored;
@@ -376,6 +407,7 @@ bool PositionPredictor::contextsOf(uint32_t vertex, int level, SingleContexts& c
   c.parallelogram =
       (plane * kSpreadClasses + spreadClass(f.parallelogramSpread)) * kParallelogramBuckets + f.parallelogram;
   parallelogramPredictions_ += f.hasParallelogram;
+  c.refinement = refinementClass(around, f.mirrored) * 2 + (tilt >= 2);
   c.parallelogramOdds.fast = c.parallelogramOdds.slow =
       f.hasParallelogram ? parallelogramOdds(f.parallelogramOffset, f.parallelogramSpread) : kProbabilityOne / 2;
   return true;
@@ -383,13 +415,30 @@ bool PositionPredictor::contextsOf(uint32_t vertex, int level, SingleContexts& c
 
 CountContext PositionPredictor::countContext(uint32_t vertex, int level) {
   Neighbourhood around;
-  if (!gather(vertex, axis_[size_t(level)], around)) return {};
+  if (!gather(vertex, level, around)) return {};
   ++countPredictions_;
   const Features f = features(around, level);
   parallelogramPredictions_ += f.hasParallelogram;
   CountContext context = countContextOf(f);
   context.parallelogram = f.parallelogram;
+  context.refinement = refinementClass(around, f.mirrored);
   return context;
+}
+
+// The neighbours of the cell's slab that went to its upper half, to its
+// lower half (up to 3 each), those not split yet (up to 3), and whether
+// any already split lies just above the cell or just below it (in the
+// half of the next slab that touches the cell): 4 · 4 · 4 · 2 · 2 classes.
+int PositionPredictor::refinementClass(const Neighbourhood& around, bool mirrored) {
+  const std::array<uint32_t, 10>& bins = around.alongAxis;
+  refinedNeighbourPredictions_ += bins[3] + bins[5] > 0;
+  uint32_t upper = bins[5], lower = bins[3], justAbove = bins[6], justBelow = bins[2];
+  if (mirrored) {
+    std::swap(upper, lower);
+    std::swap(justAbove, justBelow);
+  }
+  const uint32_t halves = std::min(upper, 3u) * 4 + std::min(lower, 3u);
+  return int(((halves * 4 + std::min(bins[4], 3u)) * 2 + (justAbove > 0)) * 2 + (justBelow > 0));
 }
 
 CountContext PositionPredictor::countContextOf(const Features& f) {

@@ -36,12 +36,24 @@
 //     −0.24; the median and its deviation, robust against the
 //     parallelograms that span a crease or a fold, took another −0.26,
 //     −0.26 and −0.25 on the first three).
+// And one more, from the order of coding: cells split level by level, so
+// the neighbours coded before the vertex at this level are known to half
+// a cell more. A neighbour in the cell's own slab along the split axis
+// that went to one half says much of a surface near it: the vertex tends
+// to the same half, the more so the flatter the surface lies across the
+// axis (on the fandisk's faces, which are flat, nearly always). The
+// refinement class counts those neighbours by half, the slab's neighbours
+// not split yet, and whether any already split lies just beyond the cell's
+// bounds (bunny −0.71 bits per vertex, dragon −1.12, fandisk −0.62,
+// triceratops −0.13).
+//
 // The configuration is mirrored so that the prediction points to the upper
 // half, which lets the two mirror images share statistics. A one-vertex split
-// mixes four models chosen by these features (mixer.h) and, as a fifth
-// input, the odds of the upper half computed from the parallelograms' median
-// offset over their deviation, unbucketed; the split of a cell of several
-// vertices gets a class for CountCoder.
+// mixes four models chosen by these features (mixer.h), as a fifth input
+// the odds of the upper half computed from the parallelograms' median
+// offset over their deviation, unbucketed, and as a sixth a model chosen by
+// the refinement class; the split of a cell of several vertices gets
+// classes for CountCoder.
 #pragma once
 
 #include <algorithm>
@@ -78,6 +90,10 @@ int countAtMost(double t, const double (&bounds)[kCount]) {
   return below;
 }
 
+// Where a neighbour lies along the split axis, from its offset in half
+// widths of the cell: a bin of 0..9 (position_predictor.cpp).
+int alongBin(double offset);
+
 // The median of values[0..count), count > 0, and the median of their
 // absolute deviations from it (the values may be reordered). Values, not
 // positions, are what count: encoder and decoder agree whatever the sort.
@@ -85,9 +101,9 @@ void medianAndDeviation(double* values, uint32_t count, double& median, double& 
 
 class PositionPredictor {
  public:
-  // Inputs of the one-vertex mixers: the four models and the parallelogram
-  // odds.
-  static constexpr int kSingleInputs = 5;
+  // Inputs of the one-vertex mixers: four models of the neighbourhood's
+  // shape, the parallelogram odds and the refinement class's model.
+  static constexpr int kSingleInputs = 6;
 
   // `store`: the complex the predictions read, as it changes.
   PositionPredictor(const SplitSchedule& schedule, const SimplexStore& store);
@@ -122,7 +138,8 @@ class PositionPredictor {
           coder, std::array<Mixer<kSingleInputs>*, 3>{&mixer_, &parallelogramMixer_, &planeAndCentroidMixer_},
           {c.mixerSet, c.parallelogramMixerSet, c.planeAndCentroidMixerSet},
           {&models_[size_t(c.joint)], &planeModels_[size_t(c.plane)], &centroidModels_[size_t(c.centroid)],
-           &parallelogramModels_[size_t(c.parallelogram)], &c.parallelogramOdds},
+           &parallelogramModels_[size_t(c.parallelogram)], &c.parallelogramOdds,
+           &refinementModels_[size_t(c.refinement)]},
           inFirstHalf != c.mirrored);
       first = bit != c.mirrored;
     }
@@ -152,6 +169,7 @@ class PositionPredictor {
   const std::vector<BitModel>& planeModels() const { return planeModels_; }
   const std::vector<BitModel>& centroidModels() const { return centroidModels_; }
   const std::vector<BitModel>& parallelogramModels() const { return parallelogramModels_; }
+  const std::vector<BitModel>& refinementModels() const { return refinementModels_; }
   // One of the three mixers of one-vertex splits.
   const Mixer<kSingleInputs>& mixer(MixerFamily family) const {
     return family == MixerFamily::OneVertexByParallelogram      ? parallelogramMixer_
@@ -164,6 +182,7 @@ class PositionPredictor {
     statistics.countPredictions += countPredictions_;
     statistics.positionPredictions += positionPredictions_;
     statistics.parallelogramPredictions += parallelogramPredictions_;
+    statistics.refinedNeighbourPredictions += refinedNeighbourPredictions_;
   }
 
  private:
@@ -188,6 +207,9 @@ class PositionPredictor {
     double parallelogramMedian, parallelogramDeviation;
     uint32_t count, parallelograms;
     bool oriented;
+    // The neighbours by where they lie along the split axis (alongBin() in
+    // position_predictor.cpp).
+    std::array<uint32_t, 10> alongAxis;
   };
   // The predictions against the split at `level`, in half widths of the
   // cell along the split axis, mirrored so that the plane (or without one,
@@ -206,9 +228,12 @@ class PositionPredictor {
     bool outsideUp = false;  // an oriented normal points to the upper half
   };
   Features features(const Neighbourhood& around, int level) const;
-  // Sums the neighbours of `vertex` (squaredAlong along `axis`); false
+  // Sums the neighbours of `vertex` against the split of `level`; false
   // without any.
-  bool gather(uint32_t vertex, int axis, Neighbourhood& around);
+  bool gather(uint32_t vertex, int level, Neighbourhood& around);
+  // The refinement class (0..CountContext::kRefinementClasses-1) of
+  // gathered neighbours, mirrored as the features.
+  int refinementClass(const Neighbourhood& around, bool mirrored);
   // The vertex c of a triangle b a c across the edge a b (wound a b), or
   // kNoSimplex; `slot` (triangle · 3 + position) names the triangle
   // v a b whose edge it is, under which the answer is remembered.
@@ -223,6 +248,7 @@ class PositionPredictor {
   struct SingleContexts {
     int joint, plane, centroid, parallelogram;
     int mixerSet, parallelogramMixerSet, planeAndCentroidMixerSet;
+    int refinement;  // refinementClass() and the tilt (< 1, or more or no plane)
     bool mirrored;
     // Holds, for this bit alone, the odds of the upper half that the
     // parallelogram predictions give (parallelogramOdds() in
@@ -249,11 +275,12 @@ class PositionPredictor {
   std::vector<uint32_t> acrossSlots_;
   // The parallelogram predictions of one gather(), and their deviations.
   std::vector<double> predictions_;
-  std::vector<BitModel> models_, planeModels_, centroidModels_, parallelogramModels_;
+  std::vector<BitModel> models_, planeModels_, centroidModels_, parallelogramModels_, refinementModels_;
   Mixer<kSingleInputs> mixer_, parallelogramMixer_, planeAndCentroidMixer_;
   uint64_t countPredictions_ = 0;
   uint64_t positionPredictions_ = 0;
   uint64_t parallelogramPredictions_ = 0;
+  uint64_t refinedNeighbourPredictions_ = 0;
 };
 
 }  // namespace kdmesh

@@ -33,6 +33,7 @@ constexpr const char* kNames[kFamilies] = {"kOneVertexSplitPriors", "kEdgeCodePr
                                            "kTriangleCodePriors", "kOneVertexByParallelogramPriors",
                                            "kCellCountByParallelogramPriors", "kEdgeCodeByBalancePriors",
                                            "kEdgeCodeByRunPriors", "kVertexCodePriors",
+                                           "kOneVertexByRefinementPriors", "kCellCountByRefinementPriors",
                                            "kOneVertexMixerPriors",
                                            "kCellCountMixerPriors",
                                            "kOneVertexByParallelogramMixerPriors",

@@ -67,6 +67,10 @@ TEST(Connectivity, PredictorsRunAlikeOnBothSides) {
     EXPECT_EQ(theirs.pairedTriangles, mine.pairedTriangles);
     EXPECT_EQ(theirs.closedFanEdgeCodes, mine.closedFanEdgeCodes);
     EXPECT_EQ(theirs.cutCandidatePairs, mine.cutCandidatePairs);
+    EXPECT_EQ(theirs.refinedNeighbourPredictions, mine.refinedNeighbourPredictions);
+    // Cells split level by level: about half a vertex's neighbours split
+    // before it, some in its own slab.
+    EXPECT_GT(mine.refinedNeighbourPredictions * 10, mine.positionPredictions + mine.countPredictions);
     // Surfaces split mostly by edge expansions; tetrahedral meshes have
     // triangles between cut edges.
     if (c.surface) {

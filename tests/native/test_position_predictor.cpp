@@ -1,4 +1,5 @@
-// The robust statistics of the parallelogram predictions (position_predictor.h).
+// The robust statistics of the parallelogram predictions and the placing of
+// neighbours along the split axis (position_predictor.h).
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -69,6 +70,26 @@ TEST(MedianAndDeviation, MatchesTheDefinitionForEveryCount) {
       ASSERT_EQ(deviation, expectedDeviation) << count << " values, trial " << trial;
     }
   }
+}
+
+// Neighbours placed as the decoder places them: cell centres of one level
+// (p·w + (w − 1)/2), some moved a quarter width into the half they split
+// to, offsets from the cell at hand in its half widths.
+TEST(AlongBin, PlacesNeighboursBySlabAndSide) {
+  for (const double width : {1.0, 2.0, 64.0, 1048576.0}) {
+    const double halfWidth = width / 2, quarter = width / 4;
+    const double mine = 37 * width + (width - 1) / 2;
+    for (int slab = -4; slab <= 4; ++slab) {
+      for (int side = -1; side <= 1; ++side) {
+        const double theirs = (37 + slab) * width + (width - 1) / 2 + side * quarter;
+        const int expected = slab >= -1 && slab <= 1 ? 3 * (slab + 1) + side + 1 : 9;
+        EXPECT_EQ(alongBin((theirs - mine) * (1 / halfWidth)), expected) << width << " " << slab << " " << side;
+      }
+    }
+  }
+  // Far off on a 30-bit grid, with no overflow.
+  EXPECT_EQ(alongBin(std::ldexp(1.0, 31) + 0.5), 9);
+  EXPECT_EQ(alongBin(-std::ldexp(1.0, 31) - 0.5), 9);
 }
 
 }  // namespace

@@ -187,6 +187,10 @@ struct ConnectivityStatistics {
   // criterion and the two candidates' valences.
   uint64_t closedFanEdgeCodes = 0;
   uint64_t cutCandidatePairs = 0;
+  // Cell counts and one-vertex splits from the neighbourhood (the two
+  // counters above) with a neighbour in the cell's slab along the split
+  // axis that has split at this level already (the refinement class).
+  uint64_t refinedNeighbourPredictions = 0;
 };
 
 struct EncodeResult {
