@@ -253,10 +253,10 @@ int runInfo(const std::string& input, bool json) {
     std::printf("  \"predictions\": {\"edgeCodesByDirection\": %" PRIu64 ", \"countPredictions\": %" PRIu64
                 ", \"positionPredictions\": %" PRIu64 ", \"parallelogramPredictions\": %" PRIu64
                 ", \"pairedTriangles\": %" PRIu64 ", \"closedFanEdgeCodes\": %" PRIu64
-                ", \"cutCandidatePairs\": %" PRIu64 ", \"refinedNeighbourPredictions\": %" PRIu64 "},\n",
+                ", \"cutCandidatePairs\": %" PRIu64 ", \"refinedNeighbourPredictions\": %" PRIu64 ", \"proxyPredictions\": %" PRIu64 "},\n",
                 stats.edgeCodesByDirection, stats.countPredictions, stats.positionPredictions,
                 stats.parallelogramPredictions, stats.pairedTriangles, stats.closedFanEdgeCodes,
-                stats.cutCandidatePairs, stats.refinedNeighbourPredictions);
+                stats.cutCandidatePairs, stats.refinedNeighbourPredictions, stats.proxyPredictions);
     std::printf("  \"chunks\": [");
     const auto& chunks = decoder.chunks();
     for (size_t i = 0; i < chunks.size(); ++i)
@@ -299,11 +299,13 @@ int runInfo(const std::string& input, bool json) {
                 stats.orientationMispredicted);
     std::printf("predictions     %" PRIu64 " edge codes by split direction, %" PRIu64
                 " cell counts and %" PRIu64 " one-vertex splits from the neighbourhood (%" PRIu64
-                " of them with parallelograms, %" PRIu64 " with neighbours split at the level already), %" PRIu64
+                " of them with parallelograms, %" PRIu64 " with neighbours split at the level already, %" PRIu64
+                " of vertices in no simplex from the vertex they split from), %" PRIu64
                 " triangles by pairing, %" PRIu64 " edge codes by their run around a closed fan (%" PRIu64
                 " of two cut candidates)\n",
                 stats.edgeCodesByDirection, stats.countPredictions, stats.positionPredictions,
-                stats.parallelogramPredictions, stats.refinedNeighbourPredictions, stats.pairedTriangles,
+                stats.parallelogramPredictions, stats.refinedNeighbourPredictions, stats.proxyPredictions,
+                stats.pairedTriangles,
                 stats.closedFanEdgeCodes, stats.cutCandidatePairs);
   }
   std::printf("chunks          %zu\n", decoder.chunks().size());

@@ -382,9 +382,41 @@ bool PositionPredictor::gather(uint32_t vertex, int level, Neighbourhood& around
   return true;
 }
 
+void PositionPredictor::adoptNeighbourhood(uint32_t isolated, uint32_t sibling, bool siblingIsolated) {
+  const uint32_t proxy = siblingIsolated ? (sibling < proxies_.size() ? proxies_[sibling] : kNoSimplex) : sibling;
+  if (proxy == kNoSimplex && isolated >= proxies_.size()) return;
+  if (isolated >= proxies_.size()) proxies_.resize(std::max<size_t>(isolated + 1, proxies_.size() * 2), kNoSimplex);
+  proxies_[isolated] = proxy;
+}
+
+bool PositionPredictor::gatherFromProxy(uint32_t vertex, int level, Neighbourhood& around) {
+  uint32_t proxy = vertex;
+  for (int hop = 0; hop < kProxyHops; ++hop) {
+    proxy = proxy < proxies_.size() ? proxies_[proxy] : kNoSimplex;
+    if (proxy == kNoSimplex) return false;
+    if (gather(proxy, level, around)) break;
+    if (hop + 1 == kProxyHops) return false;
+  }
+  const int axis = axis_[size_t(level)];
+  const double* from = places_[vertex].centre;
+  const double* to = places_[proxy].centre;
+  around.squaredDistance = 0;
+  for (int a = 0; a < 3; ++a) {
+    around.sum[a] = to[a] - from[a];
+    around.squaredDistance += around.sum[a] * around.sum[a];
+  }
+  around.squaredAlong = around.sum[axis] * around.sum[axis];
+  around.count = 1;
+  around.parallelograms = 0;
+  around.alongAxis = {};
+  ++around.alongAxis[size_t(alongBin(around.sum[axis] * inverseHalfWidths_[size_t(level)]))];
+  ++proxyPredictions_;
+  return true;
+}
+
 bool PositionPredictor::contextsOf(uint32_t vertex, int level, SingleContexts& c) {
   Neighbourhood around;
-  if (!gather(vertex, level, around)) return false;
+  if (!gather(vertex, level, around) && !gatherFromProxy(vertex, level, around)) return false;
   ++positionPredictions_;
   const Features f = features(around, level);
   c.mirrored = f.mirrored;

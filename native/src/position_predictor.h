@@ -150,6 +150,14 @@ class PositionPredictor {
     return first;
   }
 
+  // A split left `isolated` in no simplex and its cell's other half, the
+  // vertex `sibling`, with the simplices (or both in none: `sibling` is
+  // then the isolated vertex that split, whose proxy passes on). A vertex
+  // in no simplex of a surface mesh (the bunny has 1,113, in the holes of
+  // its scan) lies on or near the surface all the same: its one-vertex
+  // splits are predicted from the sibling it left (proxy()).
+  void adoptNeighbourhood(uint32_t isolated, uint32_t sibling, bool siblingIsolated);
+
   // The split of the triangle's vertex at `position` may have changed its
   // neighbours across the two edges through that vertex: across() will
   // search for them again.
@@ -183,6 +191,7 @@ class PositionPredictor {
     statistics.positionPredictions += positionPredictions_;
     statistics.parallelogramPredictions += parallelogramPredictions_;
     statistics.refinedNeighbourPredictions += refinedNeighbourPredictions_;
+    statistics.proxyPredictions += proxyPredictions_;
   }
 
  private:
@@ -256,6 +265,12 @@ class PositionPredictor {
     BitModel parallelogramOdds;
   };
   bool contextsOf(uint32_t vertex, int level, SingleContexts& contexts);
+  // The neighbourhood of a vertex in no simplex: its proxy as its one
+  // neighbour, with the plane of the proxy's own neighbourhood (no
+  // parallelograms: they predict the proxy). The proxy is the first vertex
+  // with neighbours along the chain of proxies (at most kProxyHops).
+  bool gatherFromProxy(uint32_t vertex, int level, Neighbourhood& around);
+  static constexpr int kProxyHops = 8;
   // The neighbourhood class of a cell's count from the plane or centroid.
   static CountContext countContextOf(const Features& f);
 
@@ -266,6 +281,7 @@ class PositionPredictor {
   // would, without a division's latency.
   std::vector<double> inverseHalfWidths_;
   std::vector<Place> places_;
+  std::vector<uint32_t> proxies_;  // per vertex in no simplex, else kNoSimplex
   const SimplexStore& store_;
   // Per triangle slot (see across()), the slot of the far vertex c of the
   // triangle found across the edge opposite the slot's vertex (kNowhere: no
@@ -281,6 +297,7 @@ class PositionPredictor {
   uint64_t positionPredictions_ = 0;
   uint64_t parallelogramPredictions_ = 0;
   uint64_t refinedNeighbourPredictions_ = 0;
+  uint64_t proxyPredictions_ = 0;
 };
 
 }  // namespace kdmesh

@@ -382,6 +382,15 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int
   }
 
   statistics_.edgeExpansions += star_[0].code == 4 && cutEdges == 2 && !codedThree;
+  if (star_[0].code == 3) {  // v and v2 not joined: is either left in no simplex?
+    bool toFirst = false, toSecond = false;
+    for (size_t i = 1; i < star_.size(); ++i) {
+      toFirst |= star_[i].code != 2;
+      toSecond |= star_[i].code != 1;
+    }
+    if (!toSecond) geometry_.adoptNeighbourhood(v2, v, !toFirst);
+    else if (!toFirst) geometry_.adoptNeighbourhood(v, v2, false);
+  }
   for (int d = 1; d <= SimplexStore::kMaxDimension; ++d) store_.detach(d, v);
   if (star_[0].code == 4) {
     const uint32_t edge[2] = {v, v2};

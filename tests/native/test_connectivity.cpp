@@ -2,6 +2,7 @@
 // kind, and the prefix property (every prefix is the projection of the input).
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <set>
 
 #include "complexes.h"
@@ -115,6 +116,29 @@ TEST(Connectivity, PolylinesAndIsolatedPoints) {
   for (uint32_t i = 0; i + 1 < 30; ++i) c.edges.insert(c.edges.end(), {i, i + 1});
   c.edges.insert(c.edges.end(), {29, 0, 35, 36, 36, 37});  // a loop and a separate polyline
   expectExactRoundTrip(c);  // vertices 30..34 and 38..59 are isolated points
+}
+
+// Points in no simplex on a surface (as in the holes of a scan) are
+// predicted from the vertex they split from; encoder and decoder agree.
+TEST(Connectivity, PointsInNoSimplexOnASurface) {
+  Complex c = sphereMesh(16, 24);
+  const uint32_t meshVertices = uint32_t(c.vertexCount());
+  const std::vector<float> cloud = uniformCloud(40, 17, 2.f);
+  for (size_t i = 0; i + 2 < cloud.size(); i += 3) {
+    const float x = cloud[i] - 1, y = cloud[i + 1] - 1, z = cloud[i + 2] - 1;
+    const float length = std::sqrt(x * x + y * y + z * z);
+    if (length > 0) c.positions.insert(c.positions.end(), {x / length, y / length, z / length});
+  }
+  ASSERT_GT(c.vertexCount(), meshVertices + 5);
+  expectExactRoundTrip(c);
+  EncodeOptions options;
+  options.bits = 12;
+  EncodeResult encoded;
+  roundTrip(c, options, &encoded);
+  Decoder decoder;
+  ASSERT_TRUE(decoder.push(encoded.bytes.data(), encoded.bytes.size()).ok());
+  EXPECT_GT(encoded.statistics.proxyPredictions, 0u);
+  EXPECT_EQ(decoder.statistics().proxyPredictions, encoded.statistics.proxyPredictions);
 }
 
 TEST(Connectivity, TetrahedralMesh) { expectExactRoundTrip(tetrahedralBlock(4, 3)); }

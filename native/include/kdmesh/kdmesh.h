@@ -191,6 +191,9 @@ struct ConnectivityStatistics {
   // counters above) with a neighbour in the cell's slab along the split
   // axis that has split at this level already (the refinement class).
   uint64_t refinedNeighbourPredictions = 0;
+  // One-vertex splits of vertices in no simplex, predicted from the vertex
+  // they split from (its cell's other half at the split that isolated them).
+  uint64_t proxyPredictions = 0;
 };
 
 struct EncodeResult {
