@@ -12,7 +12,7 @@
 
 namespace kdmesh {
 
-constexpr uint16_t kFormatVersion = 15;
+constexpr uint16_t kFormatVersion = 16;
 
 // Writes the header (its headerBytes field is ignored) and returns its size.
 size_t writeHeader(const Header& header, uint8_t* out /* kMaxHeaderBytes */);

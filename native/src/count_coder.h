@@ -15,8 +15,9 @@
 //     node: few cells are that large (bunny −0.06 bits per vertex; −0.05
 //     with a row per bit width of the population, which learns more
 //     slowly),
-//   - and by where the neighbours already refined at this level lie
-//     (PositionPredictor::refinementClass), a fourth model mixed in.
+//   - and by where the neighbours lie along the split axis, and which of
+//     them have split at this level already (PositionPredictor::
+//     refinementClass), a fourth model mixed in.
 // After six decisions the few remaining candidates of a large cell are nearly
 // equiprobable and are coded uniformly.
 #pragma once
@@ -46,9 +47,10 @@ struct CountContext {
   // (PositionPredictor), kParallelogramBuckets - 1 for nowhere.
   static constexpr int kParallelogramBuckets = 12;
   int parallelogram = kParallelogramBuckets - 1;
-  // Where the neighbours that have split at this level already lie
-  // (PositionPredictor::refinementClass), 0..kRefinementClasses-1.
-  static constexpr int kRefinementClasses = 256;
+  // Where the neighbours lie along the split axis, and which have split at
+  // this level already (PositionPredictor::refinementClass without the far
+  // halves), 0..kRefinementClasses-1.
+  static constexpr int kRefinementClasses = 1024;
   int refinement = 0;
 };
 
@@ -73,7 +75,7 @@ class CountCoder {
                     kFamilySize[int(ModelFamily::CellCountsByParallelogram)]);
       parallelogramModels_.resize(kFamilySize[int(ModelFamily::CellCountsByParallelogram)]);
       primeModels(ModelFamily::CellCountsByParallelogram, parallelogramModels_.data());
-      static_assert(size_t(CountContext::kRefinementClasses) * kPopulationGroups * kRefinementNodes ==
+      static_assert(size_t(CountContext::kRefinementClasses) * kRefinementNodes ==
                     kFamilySize[int(ModelFamily::CellCountsByRefinement)]);
       refinementModels_.resize(kFamilySize[int(ModelFamily::CellCountsByRefinement)]);
       primeModels(ModelFamily::CellCountsByRefinement, refinementModels_.data());
@@ -128,13 +130,11 @@ class CountCoder {
                                            context.parallelogram) *
                                     kParallelogramNodes]
             : nullptr;
-    // And with the model of where the neighbours already refined at this
-    // level lie, by population group and tree node (the root, the two of
-    // the second decision, then one).
+    // And with the model of where the neighbours lie along the split axis,
+    // by tree node (the root, the two of the second decision, then one;
+    // by population group as well: 20 KB more priors, no gain).
     BitModel* byRefinement =
-        neighbourhoodClass > 0
-            ? &refinementModels_[size_t(context.refinement * kPopulationGroups + populationGroup) * kRefinementNodes]
-            : nullptr;
+        neighbourhoodClass > 0 ? &refinementModels_[size_t(context.refinement) * kRefinementNodes] : nullptr;
     uint32_t low = 0, candidates = population + 1, node = 1;
     while (candidates > 1) {
       if (node >= kTreeNodes)
@@ -145,7 +145,7 @@ class CountCoder {
         upper = mixer_.code(coder, context.elongation * kNeighbourhoodClasses + neighbourhoodClass,
                             {&byNeighbourhood[node], &models[node],
                              &byParallelogram[std::min(node, kParallelogramNodes - 1)],
-                             &byRefinement[std::min(node, kRefinementNodes - 1)]},
+                             &byRefinement[std::min(node, kRefinementNodes) - 1]},
                             upper);
       else
         upper = coder.bit(models[node], upper);

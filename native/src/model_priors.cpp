@@ -59,6 +59,8 @@ static_assert(expandedSize(kCellCountByParallelogramPriors) == kFamilySize[8]);
 static_assert(expandedSize(kEdgeCodeByBalancePriors) == kFamilySize[9]);
 static_assert(expandedSize(kEdgeCodeByRunPriors) == kFamilySize[10]);
 static_assert(expandedSize(kVertexCodePriors) == kFamilySize[11]);
+static_assert(expandedSize(kOneVertexByRefinementPriors) == kFamilySize[12]);
+static_assert(expandedSize(kCellCountByRefinementPriors) == kFamilySize[13]);
 
 struct CodedFamily {
   const uint8_t* values;

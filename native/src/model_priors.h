@@ -37,7 +37,7 @@ enum class ModelFamily {
 };
 constexpr int kModelFamilies = 14;
 constexpr std::array<size_t, kModelFamilies> kFamilySize = {9000, 11760, 3042, 300, 250, 294, 864,
-                                                            648,  768,   2646, 1980, 36, 512, 4096};
+                                                            648,  768,   2646, 1980, 36, 8192, 4096};
 
 // model_priors.inc holds each family run-length coded: half the models of
 // the large families were never used in training and start at 1/2; a run of

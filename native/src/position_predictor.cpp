@@ -194,7 +194,7 @@ PositionPredictor::PositionPredictor(const SplitSchedule& schedule, const Simple
       planeModels_(size_t(kOutsideClasses) * kScaleClasses * kTiltClasses * kPlaneBuckets),
       centroidModels_(size_t(kValenceClasses) * kScaleClasses * kCentroidBuckets),
       parallelogramModels_(size_t(kPlaneBuckets) * kSpreadClasses * kParallelogramBuckets),
-      refinementModels_(size_t(CountContext::kRefinementClasses) * 2),
+      refinementModels_(size_t(CountContext::kRefinementClasses) * 4 * 2),
       mixer_(kElongationGroups * kScaleClasses * kAgreementClasses, mixerPriors(MixerFamily::OneVertexSplits)),
       parallelogramMixer_(kParallelogramBuckets, mixerPriors(MixerFamily::OneVertexByParallelogram)),
       planeAndCentroidMixer_(kCentroidBuckets * kPlaneBuckets, mixerPriors(MixerFamily::OneVertexByPlaneAndCentroid)) {
@@ -218,7 +218,8 @@ PositionPredictor::PositionPredictor(const SplitSchedule& schedule, const Simple
   primeModels(ModelFamily::OneVertexByPlane, planeModels_.data());
   primeModels(ModelFamily::OneVertexByCentroid, centroidModels_.data());
   primeModels(ModelFamily::OneVertexByParallelogram, parallelogramModels_.data());
-  static_assert(size_t(CountContext::kRefinementClasses) * 2 == kFamilySize[int(ModelFamily::OneVertexByRefinement)]);
+  static_assert(size_t(CountContext::kRefinementClasses) * 4 * 2 ==
+                kFamilySize[int(ModelFamily::OneVertexByRefinement)]);
   primeModels(ModelFamily::OneVertexByRefinement, refinementModels_.data());
   widths_.resize(size_t(schedule.levels) + 1);
   for (size_t level = 0; level < widths_.size(); ++level)
@@ -439,7 +440,7 @@ bool PositionPredictor::contextsOf(uint32_t vertex, int level, SingleContexts& c
   c.parallelogram =
       (plane * kSpreadClasses + spreadClass(f.parallelogramSpread)) * kParallelogramBuckets + f.parallelogram;
   parallelogramPredictions_ += f.hasParallelogram;
-  c.refinement = refinementClass(around, f.mirrored) * 2 + (tilt >= 2);
+  c.refinement = refinementClass(around, f.mirrored, true) * 2 + (tilt >= 2);
   c.parallelogramOdds.fast = c.parallelogramOdds.slow =
       f.hasParallelogram ? parallelogramOdds(f.parallelogramOffset, f.parallelogramSpread) : kProbabilityOne / 2;
   return true;
@@ -453,24 +454,27 @@ CountContext PositionPredictor::countContext(uint32_t vertex, int level) {
   parallelogramPredictions_ += f.hasParallelogram;
   CountContext context = countContextOf(f);
   context.parallelogram = f.parallelogram;
-  context.refinement = refinementClass(around, f.mirrored);
+  context.refinement = refinementClass(around, f.mirrored, false);
   return context;
 }
 
 // The neighbours of the cell's slab that went to its upper half, to its
-// lower half (up to 3 each), those not split yet (up to 3), and whether
-// any already split lies just above the cell or just below it (in the
-// half of the next slab that touches the cell): 4 · 4 · 4 · 2 · 2 classes.
-int PositionPredictor::refinementClass(const Neighbourhood& around, bool mirrored) {
-  const std::array<uint32_t, 10>& bins = around.alongAxis;
+// lower half and those not split yet (up to 3 each), then whether any
+// neighbour lies in the half of each slab beside the cell that touches it,
+// already split; whether any not split yet lies in each of those slabs;
+// and with `farHalves`, whether any already split lies in the far half of
+// each: 64 · 4 · 4 (· 4) classes. Mirroring reverses the axis, and so the
+// bins.
+int PositionPredictor::refinementClass(const Neighbourhood& around, bool mirrored, bool farHalves) {
+  std::array<uint32_t, 10> bins = around.alongAxis;
+  if (mirrored) std::reverse(bins.begin(), bins.begin() + 9);
   refinedNeighbourPredictions_ += bins[3] + bins[5] > 0;
-  uint32_t upper = bins[5], lower = bins[3], justAbove = bins[6], justBelow = bins[2];
-  if (mirrored) {
-    std::swap(upper, lower);
-    std::swap(justAbove, justBelow);
-  }
-  const uint32_t halves = std::min(upper, 3u) * 4 + std::min(lower, 3u);
-  return int(((halves * 4 + std::min(bins[4], 3u)) * 2 + (justAbove > 0)) * 2 + (justBelow > 0));
+  auto upTo3 = [](uint32_t count) { return std::min(count, 3u); };
+  auto pair = [&bins](size_t above, size_t below) { return uint32_t(bins[above] > 0) * 2 + uint32_t(bins[below] > 0); };
+  uint32_t c = (upTo3(bins[5]) * 4 + upTo3(bins[3])) * 4 + upTo3(bins[4]);
+  c = (c * 4 + pair(6, 2)) * 4 + pair(7, 1);
+  if (farHalves) c = c * 4 + pair(8, 0);
+  return int(c);
 }
 
 CountContext PositionPredictor::countContextOf(const Features& f) {

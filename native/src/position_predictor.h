@@ -42,10 +42,10 @@
 // that went to one half says much of a surface near it: the vertex tends
 // to the same half, the more so the flatter the surface lies across the
 // axis (on the fandisk's faces, which are flat, nearly always). The
-// refinement class counts those neighbours by half, the slab's neighbours
-// not split yet, and whether any already split lies just beyond the cell's
-// bounds (bunny −0.71 bits per vertex, dragon −1.12, fandisk −0.62,
-// triceratops −0.13).
+// refinement class counts those neighbours by half and the slab's
+// neighbours not split yet, and says which halves of the two slabs beside
+// the cell hold a neighbour (bunny −0.87 bits per vertex, fandisk −0.81,
+// triceratops −0.37, dragon −1.27, with its cell-count model).
 //
 // The configuration is mirrored so that the prediction points to the upper
 // half, which lets the two mirror images share statistics. A one-vertex split
@@ -240,9 +240,11 @@ class PositionPredictor {
   // Sums the neighbours of `vertex` against the split of `level`; false
   // without any.
   bool gather(uint32_t vertex, int level, Neighbourhood& around);
-  // The refinement class (0..CountContext::kRefinementClasses-1) of
-  // gathered neighbours, mirrored as the features.
-  int refinementClass(const Neighbourhood& around, bool mirrored);
+  // The refinement class of gathered neighbours, mirrored as the features:
+  // 0..CountContext::kRefinementClasses-1, or 4 times as many with
+  // `farHalves` (whether the far halves of the slabs beside the cell hold
+  // a neighbour already split).
+  int refinementClass(const Neighbourhood& around, bool mirrored, bool farHalves);
   // The vertex c of a triangle b a c across the edge a b (wound a b), or
   // kNoSimplex; `slot` (triangle · 3 + position) names the triangle
   // v a b whose edge it is, under which the answer is remembered.
@@ -257,7 +259,7 @@ class PositionPredictor {
   struct SingleContexts {
     int joint, plane, centroid, parallelogram;
     int mixerSet, parallelogramMixerSet, planeAndCentroidMixerSet;
-    int refinement;  // refinementClass() and the tilt (< 1, or more or no plane)
+    int refinement;  // refinementClass() with far halves, and the tilt (< 1, or more or no plane)
     bool mirrored;
     // Holds, for this bit alone, the odds of the upper half that the
     // parallelogram predictions give (parallelogramOdds() in
