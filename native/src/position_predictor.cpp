@@ -81,6 +81,8 @@ int spreadClass(double spread) {
   return countAtMost(spread, kBounds);
 }
 
+}  // namespace
+
 // Where a neighbour lies along the split axis, from its offset from the
 // cell's centre in half widths of the cell: cells of this level lie 2
 // apart, and one that has split at this level already 0.5 off that grid,
@@ -91,8 +93,6 @@ int spreadClass(double spread) {
 // integer of magnitude below 2^33, so integers place it: the quarter
 // 4 · slab + side. Biased to be positive, its shift and mask are a floor
 // and a modulo.
-}  // namespace
-
 int alongBin(double offset) {
   constexpr int64_t kBias = int64_t(1) << 36;
   const uint64_t quarters = uint64_t(int64_t(offset * 2) + kBias);

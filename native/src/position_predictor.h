@@ -155,7 +155,7 @@ class PositionPredictor {
   // then the isolated vertex that split, whose proxy passes on). A vertex
   // in no simplex of a surface mesh (the bunny has 1,113, in the holes of
   // its scan) lies on or near the surface all the same: its one-vertex
-  // splits are predicted from the sibling it left (proxy()).
+  // splits are predicted from the sibling it left (gatherFromProxy()).
   void adoptNeighbourhood(uint32_t isolated, uint32_t sibling, bool siblingIsolated);
 
   // The split of the triangle's vertex at `position` may have changed its
@@ -243,7 +243,8 @@ class PositionPredictor {
   // The refinement class of gathered neighbours, mirrored as the features:
   // 0..CountContext::kRefinementClasses-1, or 4 times as many with
   // `farHalves` (whether the far halves of the slabs beside the cell hold
-  // a neighbour already split).
+  // a neighbour already split). Counts the predictions with a neighbour
+  // split in the cell's slab.
   int refinementClass(const Neighbourhood& around, bool mirrored, bool farHalves);
   // The vertex c of a triangle b a c across the edge a b (wound a b), or
   // kNoSimplex; `slot` (triangle · 3 + position) names the triangle
