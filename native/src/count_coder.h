@@ -132,7 +132,8 @@ class CountCoder {
             : nullptr;
     // And with the model of where the neighbours lie along the split axis,
     // by tree node (the root, the two of the second decision, then one;
-    // by population group as well: 20 KB more priors, no gain).
+    // by population group as well: 14.7 KB more priors for ±0.016 bits per
+    // vertex).
     BitModel* byRefinement =
         neighbourhoodClass > 0 ? &refinementModels_[size_t(context.refinement) * kRefinementNodes] : nullptr;
     uint32_t low = 0, candidates = population + 1, node = 1;

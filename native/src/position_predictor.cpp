@@ -171,7 +171,7 @@ namespace {
 // predictions agree. The models bucket t and s; this input, unbucketed,
 // lets the mixers weigh how far apart within a bucket they are (bunny
 // −0.041 bits per vertex, triceratops −0.059, fandisk −0.071; scale and q
-// tuned on these three: ±0.01 around them).
+// tuned on these three: within 0.02 for scales 300–1000 and q 0.15–0.5).
 uint16_t parallelogramOdds(const double offset, const double spread) {
   constexpr double kVariance = 0.15, kScale = 700;  // squared half widths; logistic units of 1/256
   const double logit = std::clamp(kScale * offset / std::sqrt(spread + kVariance), -2047.0, 2047.0);
@@ -384,7 +384,7 @@ bool PositionPredictor::gather(uint32_t vertex, int level, Neighbourhood& around
 }
 
 void PositionPredictor::adoptNeighbourhood(uint32_t isolated, uint32_t sibling, bool siblingIsolated) {
-  const uint32_t proxy = siblingIsolated ? (sibling < proxies_.size() ? proxies_[sibling] : kNoSimplex) : sibling;
+  const uint32_t proxy = siblingIsolated ? proxyOf(sibling) : sibling;
   if (proxy == kNoSimplex && isolated >= proxies_.size()) return;
   if (isolated >= proxies_.size()) proxies_.resize(std::max<size_t>(isolated + 1, proxies_.size() * 2), kNoSimplex);
   proxies_[isolated] = proxy;
@@ -392,12 +392,13 @@ void PositionPredictor::adoptNeighbourhood(uint32_t isolated, uint32_t sibling, 
 
 bool PositionPredictor::gatherFromProxy(uint32_t vertex, int level, Neighbourhood& around) {
   uint32_t proxy = vertex;
-  for (int hop = 0; hop < kProxyHops; ++hop) {
-    proxy = proxy < proxies_.size() ? proxies_[proxy] : kNoSimplex;
+  bool found = false;
+  for (int hop = 0; hop < kProxyHops && !found; ++hop) {
+    proxy = proxyOf(proxy);
     if (proxy == kNoSimplex) return false;
-    if (gather(proxy, level, around)) break;
-    if (hop + 1 == kProxyHops) return false;
+    found = gather(proxy, level, around);
   }
+  if (!found) return false;
   const int axis = axis_[size_t(level)];
   const double* from = places_[vertex].centre;
   const double* to = places_[proxy].centre;
@@ -464,14 +465,13 @@ CountContext PositionPredictor::countContext(uint32_t vertex, int level) {
 // already split; whether any not split yet lies in each of those slabs;
 // and with `farHalves`, whether any already split lies in the far half of
 // each: 64 · 4 · 4 (· 4) classes. Mirroring reverses the axis, and so the
-// bins.
+// bins: bin i is read as bin 8 − i.
 int PositionPredictor::refinementClass(const Neighbourhood& around, bool mirrored, bool farHalves) {
-  std::array<uint32_t, 10> bins = around.alongAxis;
-  if (mirrored) std::reverse(bins.begin(), bins.begin() + 9);
-  refinedNeighbourPredictions_ += bins[3] + bins[5] > 0;
-  auto upTo3 = [](uint32_t count) { return std::min(count, 3u); };
-  auto pair = [&bins](size_t above, size_t below) { return uint32_t(bins[above] > 0) * 2 + uint32_t(bins[below] > 0); };
-  uint32_t c = (upTo3(bins[5]) * 4 + upTo3(bins[3])) * 4 + upTo3(bins[4]);
+  auto bin = [&around, mirrored](size_t i) { return around.alongAxis[mirrored ? 8 - i : i]; };
+  refinedNeighbourPredictions_ += bin(3) + bin(5) > 0;
+  auto upTo3 = [&bin](size_t i) { return std::min(bin(i), 3u); };
+  auto pair = [&bin](size_t above, size_t below) { return uint32_t(bin(above) > 0) * 2 + uint32_t(bin(below) > 0); };
+  uint32_t c = (upTo3(5) * 4 + upTo3(3)) * 4 + upTo3(4);
   c = (c * 4 + pair(6, 2)) * 4 + pair(7, 1);
   if (farHalves) c = c * 4 + pair(8, 0);
   return int(c);

@@ -157,6 +157,7 @@ class PositionPredictor {
   // its scan) lies on or near the surface all the same: its one-vertex
   // splits are predicted from the sibling it left (gatherFromProxy()).
   void adoptNeighbourhood(uint32_t isolated, uint32_t sibling, bool siblingIsolated);
+  uint32_t proxyOf(uint32_t vertex) const { return vertex < proxies_.size() ? proxies_[vertex] : kNoSimplex; }
 
   // The split of the triangle's vertex at `position` may have changed its
   // neighbours across the two edges through that vertex: across() will

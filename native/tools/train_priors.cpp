@@ -28,7 +28,7 @@ constexpr double kMaxWeight = 256;
 // keeps 1/2: its average is mostly noise, and a run of models at 1/2 takes
 // three bytes in the module however long (the refinement families of
 // format 16: 11,668 bytes of priors without the rule, 7,653 with it, at
-// +0.003 to +0.008 bits per vertex).
+// +0.001 to +0.008 bits per vertex).
 constexpr double kMinWeight = 16;
 // A weight vector is used thousands of times in a mesh, far more than a
 // model; capped too, so that no mesh dominates.
