@@ -211,7 +211,18 @@ std::string jsonNumber(double v) {
   return buffer;
 }
 
-int runInfo(const std::string& input, bool json) {
+// The largest side of a cell after `level`, in model units: each level
+// halves its axis, from 2^axisBits grid steps (grid streams only).
+double cellSideAfter(const kdmesh::Header& h, const std::vector<kdmesh::LevelCost>& levels, size_t level) {
+  std::array<int, 3> halvings{};
+  for (size_t l = 0; l <= level; ++l)
+    if (levels[l].axis >= 0) ++halvings[size_t(levels[l].axis)];
+  double side = 0;
+  for (int a = 0; a < 3; ++a) side = std::max(side, std::ldexp(h.step, h.axisBits(a) - halvings[size_t(a)]));
+  return side;
+}
+
+int runInfo(const std::string& input, bool json, bool perLevel) {
   std::vector<uint8_t> bytes;
   std::string error;
   if (!readBytes(input, bytes, error)) return fail(error);
@@ -257,6 +268,12 @@ int runInfo(const std::string& input, bool json) {
                 stats.edgeCodesByDirection, stats.countPredictions, stats.positionPredictions,
                 stats.parallelogramPredictions, stats.pairedTriangles, stats.closedFanEdgeCodes,
                 stats.cutCandidatePairs, stats.refinedNeighbourPredictions, stats.proxyPredictions);
+    std::printf("  \"levels\": [");
+    for (size_t i = 0; i < cost.levels.size(); ++i)
+      std::printf("%s\n    {\"axis\": %d, \"cells\": %u, \"geometryBits\": %s, \"connectivityBits\": %s}",
+                  i ? "," : "", cost.levels[i].axis, cost.levels[i].cells,
+                  jsonNumber(cost.levels[i].geometryBits).c_str(), jsonNumber(cost.levels[i].connectivityBits).c_str());
+    std::printf("\n  ],\n");
     std::printf("  \"chunks\": [");
     const auto& chunks = decoder.chunks();
     for (size_t i = 0; i < chunks.size(); ++i)
@@ -307,6 +324,23 @@ int runInfo(const std::string& input, bool json) {
                 stats.parallelogramPredictions, stats.refinedNeighbourPredictions, stats.proxyPredictions,
                 stats.pairedTriangles,
                 stats.closedFanEdgeCodes, stats.cutCandidatePairs);
+  }
+  if (perLevel) {
+    // How the bits build up level by level: a prefix of the stream that
+    // reaches a level holds about the header and the bits coded so far.
+    std::printf("levels          bits per vertex by kd-tree level; bytes: header and bits coded through the level\n");
+    std::printf("  %5s %4s %10s %12s %9s %12s %10s\n", "level", "axis", "cells", "cell side", "geometry",
+                "connectivity", "bytes");
+    double bitsSoFar = 0;
+    for (size_t i = 0; i < cost.levels.size(); ++i) {
+      const kdmesh::LevelCost& level = cost.levels[i];
+      bitsSoFar += level.geometryBits + level.connectivityBits;
+      char side[32] = "-";
+      if (grid) std::snprintf(side, sizeof side, "%.4g", cellSideAfter(h, cost.levels, i));
+      std::printf("  %5zu %4s %10u %12s %9.3f %12.3f %10.0f\n", i,
+                  level.axis < 0 ? "-" : level.axis == 0 ? "x" : level.axis == 1 ? "y" : "z", level.cells, side,
+                  level.geometryBits / n, level.connectivityBits / n, double(h.headerBytes) + bitsSoFar / 8);
+    }
   }
   std::printf("chunks          %zu\n", decoder.chunks().size());
   std::printf("  %5s %10s %8s %10s\n", "chunk", "offset", "payload", "splits");
@@ -364,7 +398,10 @@ int main(int argc, char** argv) {
   bool infoJson = false;
   CLI::App* info = app.add_subcommand("info", "Describe a .kdm file: header, chunks, bits per vertex");
   info->add_option("input", infoInput, "Input .kdm file")->required()->check(CLI::ExistingFile);
-  info->add_flag("--json", infoJson, "Machine-readable output");
+  info->add_flag("--json", infoJson, "Machine-readable output (lists the levels' bits)");
+  bool infoLevels = false;
+  info->add_flag("--levels", infoLevels,
+                 "Bits per vertex of every kd-tree level, with the cell size it reaches and the bytes it takes");
 
   try {
     app.parse(argc, argv);
@@ -378,7 +415,7 @@ int main(int argc, char** argv) {
   try {
     if (encode->parsed()) return runEncode(encodeArgs);
     if (decode->parsed()) return runDecode(decodeArgs);
-    return runInfo(infoInput, infoJson);
+    return runInfo(infoInput, infoJson, infoLevels);
   } catch (const std::bad_alloc&) {
     return fail("out of memory");
   } catch (const std::exception& e) {

@@ -114,7 +114,8 @@ class ChunkWriter {
 // kNoSimplex for a one-sided split), placed(id, prefix, level) for each
 // non-empty half of a geometric split, single(level, parentOneSided,
 // inFirstHalf, id) for one-vertex cells, named(keyIndex, id) when a vertex
-// gets its final id, and splitDone() after each split.
+// gets its final id, splitDone() after each split, and levelDone(level)
+// after the last split of each level.
 template <class Visitor>
 void traverseKdTree(const std::vector<KdKey>& keys, const SplitSchedule& schedule,
                     bool coincidentLevels, Visitor&& visitor) {
@@ -183,6 +184,7 @@ void traverseKdTree(const std::vector<KdKey>& keys, const SplitSchedule& schedul
       single.parentOneSided = true;
       visitor.splitDone();
     }
+    visitor.levelDone(level);
     std::inplace_merge(singles.begin(), singles.begin() + std::ptrdiff_t(oldSingles),
                        singles.end(), [](const Single& a, const Single& b) { return a.key < b.key; });
     std::swap(cells, children);
@@ -240,6 +242,7 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
       void single(int, bool, bool, uint32_t) {}
       void named(uint32_t key, uint32_t id) { ids[vertexOfKey[key]] = id; }
       void splitDone() {}
+      void levelDone(int) {}
     } naming{ids, splits, order.vertices};
     traverseKdTree(order.keys, schedule, true, naming);
     SimplexStore store;
@@ -280,7 +283,10 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
     double& connectivityBits;
     bool connectivity;
     std::function<void(const char*, double)> report;
+    std::vector<LevelCost>& levels;
     int reportedLevel = -1;
+    uint32_t levelCells = 0;
+    LevelCostTally levelCosts{};
 
     void cell(int level, bool geometric, uint32_t population, uint32_t firstHalf,
               bool parentOneSided, uint32_t kept, uint32_t added) {
@@ -288,6 +294,7 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
         reportedLevel = level;
         report("code", double(level) / double(schedule.levels + 1));
       }
+      ++levelCells;
       if (geometric)
         counts.code(coder, population, level, parentOneSided, firstHalf,
                     connectivity ? predictor.countContext(kept, level) : CountContext{});
@@ -303,6 +310,7 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
       if (connectivity) predictor.place(id, prefix, level);
     }
     void single(int level, bool parentOneSided, bool inFirstHalf, uint32_t id) {
+      ++levelCells;
       if (connectivity)
         predictor.codeSingle(coder, counts, id, level, parentOneSided, inFirstHalf);
       else
@@ -310,8 +318,12 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
     }
     void named(uint32_t, uint32_t) {}
     void splitDone() { chunks.splitDone(); }
+    void levelDone(int level) {
+      levelCosts.close(schedule, level, levelCells, coder.cost(), connectivityBits, levels);
+      levelCells = 0;
+    }
   } coding{header, schedule, counts, coder, chunks, splitter, forward, predictor, records, splitIndex,
-           connectivityBits, connectivity, report};
+           connectivityBits, connectivity, report, result.cost.levels};
   traverseKdTree(order.keys, schedule, connectivity, coding);
   header.chunkCount = chunks.finish();
   header.bodyBytes = body.size();

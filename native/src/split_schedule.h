@@ -47,4 +47,23 @@ struct SplitSchedule {
   std::vector<std::array<uint8_t, 3>> consumed;   // bits fixed before level
 };
 
+// Splits a coder's running cost by kd-tree level (CodingCost::levels): the
+// encoder and the decoder close each level after its last split.
+class LevelCostTally {
+ public:
+  // `cells`: how many the level split; `bits`, `connectivityBits`: the
+  // coder's running totals.
+  void close(const SplitSchedule& schedule, int level, uint32_t cells, double bits, double connectivityBits,
+             std::vector<LevelCost>& out) {
+    const double levelConnectivityBits = connectivityBits - startConnectivityBits_;
+    out.push_back({level < schedule.levels ? int(schedule.axis[size_t(level)]) : -1, cells,
+                   bits - startBits_ - levelConnectivityBits, levelConnectivityBits});
+    startBits_ = bits;
+    startConnectivityBits_ = connectivityBits;
+  }
+
+ private:
+  double startBits_ = 0, startConnectivityBits_ = 0;
+};
+
 }  // namespace kdmesh

@@ -14,9 +14,11 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 #include <string>
 #include <vector>
 
+#include "complexes.h"
 #include "kdmesh/io.h"
 #include "shapes.h"
 #include "test_support.h"
@@ -269,7 +271,7 @@ TEST_F(CliTest, InfoPrintsHeaderFieldsAndBitsPerVertex) {
   EXPECT_EQ(j.find("nan"), std::string::npos);
   for (const char* key : {"version", "bytes", "vertexCount", "maxDimension", "simplexCounts",
                           "quantization", "bits", "axisBits", "bitsPerVertex", "total",
-                          "geometry", "chunks"}) {
+                          "geometry", "levels", "cells", "geometryBits", "chunks"}) {
     EXPECT_NE(j.find("\"" + std::string(key) + "\":"), std::string::npos) << key << "\n" << j;
   }
   auto number = [&j](const char* key) {
@@ -288,6 +290,38 @@ TEST_F(CliTest, InfoPrintsHeaderFieldsAndBitsPerVertex) {
   runOk("encode cloud.ply -o exact.kdm --exact");
   const CliRun exact = runOk("info --json exact.kdm");
   EXPECT_NE(exact.out.find("\"quantization\": \"float32\""), std::string::npos) << exact.out;
+}
+
+// --levels adds a row per kd-tree level, whose last byte estimate is
+// about the stream's size.
+TEST_F(CliTest, InfoLevelsListsEveryLevel) {
+  writeModel("torus.obj", torusMesh(12, 20));
+  runOk("-q encode torus.obj -o torus.kdm --bits 10");
+  const CliRun plain = runOk("info torus.kdm");
+  EXPECT_EQ(plain.out.find("cell side"), std::string::npos) << plain.out;
+  const CliRun text = runOk("info --levels torus.kdm");
+  const std::string& out = text.out;
+  const size_t depthAt = out.find("kd-tree levels  ");
+  ASSERT_NE(depthAt, std::string::npos) << out;
+  const int depth = std::atoi(out.c_str() + depthAt + 16);
+  const size_t tableAt = out.find("cell side");
+  ASSERT_NE(tableAt, std::string::npos) << out;
+  std::istringstream rows(out.substr(out.find('\n', tableAt) + 1));
+  std::string row;
+  int levels = 0;
+  double lastBytes = 0;
+  while (std::getline(rows, row) && row.rfind("chunks", 0) != 0) {
+    std::istringstream fields(row);
+    int level;
+    std::string axis, cells, side, geometry, connectivity;
+    ASSERT_TRUE(fields >> level >> axis >> cells >> side >> geometry >> connectivity >> lastBytes) << row;
+    EXPECT_EQ(level, levels);
+    ++levels;
+  }
+  EXPECT_GE(levels, depth);
+  const double size = double(fs::file_size(at("torus.kdm")));
+  EXPECT_GT(lastBytes, 0.9 * size);
+  EXPECT_LE(lastBytes, size);
 }
 
 TEST_F(CliTest, QuietSuppressesProgressAndStatistics) {

@@ -6,6 +6,7 @@
 #include <limits>
 #include <random>
 
+#include "complexes.h"
 #include "container.h"
 #include "shapes.h"
 #include "test_support.h"
@@ -120,6 +121,80 @@ TEST(Stream, ProgressReportsBytesLevelsAndChunks) {
   EXPECT_NEAR(d.chunks()[1].payloadBytes, 2048, 16);
   EXPECT_NEAR(d.chunks()[2].payloadBytes, 4096, 16);
   EXPECT_NEAR(d.chunks()[3].payloadBytes, 4096, 16);
+}
+
+// The bits of every level, as the encoder counts them while coding and the
+// decoder while decoding: the same, level by level, and summing to the
+// totals; a prefix lists the levels it completed.
+TEST(Stream, CostsByLevelAddUpAndAgreeOnBothSides) {
+  struct Case {
+    const char* name;
+    Complex complex;
+    int bits;
+  };
+  const Case cases[] = {{"point cloud", pointCloud(torusSurface(3000, 34)), 10},
+                        {"surface", torusMesh(12, 20), 12},
+                        {"tetrahedra", tetrahedralBlock(4, 5), 12},
+                        {"coincident vertices, all dimensions", randomComplex(7, 60, 120), 3}};
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.name);
+    EncodeOptions options;
+    options.bits = c.bits;
+    options.chunkBytes = 64;
+    const EncodeResult encoded = encode(c.complex, options);
+    ASSERT_TRUE(encoded.status.ok()) << encoded.status.message;
+    DecoderOptions measuring;
+    measuring.measureCost = true;
+    Decoder decoder(measuring);
+    ASSERT_TRUE(decoder.push(encoded.bytes.data(), encoded.bytes.size()).ok());
+    ASSERT_TRUE(decoder.complete());
+    const Header& h = decoder.header();
+    const std::vector<LevelCost>& mine = encoded.cost.levels;
+    const std::vector<LevelCost> theirs = decoder.cost().levels;
+    ASSERT_EQ(theirs.size(), mine.size());
+    // Every geometric level halves one axis, each axis as often as it has
+    // bits; only cells of coincident vertices split further.
+    ASSERT_GE(mine.size(), size_t(h.depth()));
+    std::array<int, 3> halvings{};
+    double geometryBits = 0, connectivityBits = 0;
+    for (size_t l = 0; l < mine.size(); ++l) {
+      SCOPED_TRACE("level " + std::to_string(l));
+      EXPECT_EQ(theirs[l].axis, mine[l].axis);
+      EXPECT_EQ(theirs[l].cells, mine[l].cells);
+      EXPECT_EQ(theirs[l].geometryBits, mine[l].geometryBits);
+      EXPECT_EQ(theirs[l].connectivityBits, mine[l].connectivityBits);
+      EXPECT_GE(mine[l].geometryBits, 0.0);
+      EXPECT_GE(mine[l].connectivityBits, 0.0);
+      if (l < size_t(h.depth())) {
+        ASSERT_GE(mine[l].axis, 0);
+        ++halvings[size_t(mine[l].axis)];
+        EXPECT_GE(mine[l].cells, l == 0 ? 1u : mine[l - 1].cells);
+      } else {
+        EXPECT_EQ(mine[l].axis, -1);
+      }
+      geometryBits += mine[l].geometryBits;
+      connectivityBits += mine[l].connectivityBits;
+    }
+    EXPECT_EQ(mine[0].cells, 1u);
+    for (int a = 0; a < 3; ++a) EXPECT_EQ(halvings[size_t(a)], h.axisBits(a));
+    EXPECT_NEAR(geometryBits, encoded.cost.geometryBits, 1e-9 * encoded.cost.geometryBits);
+    EXPECT_NEAR(connectivityBits, encoded.cost.connectivityBits, 1e-9 * encoded.cost.connectivityBits + 1e-12);
+    if (c.complex.edges.empty() && c.complex.triangles.empty() && c.complex.tetrahedra.empty()) {
+      EXPECT_EQ(connectivityBits, 0.0);
+    } else {
+      EXPECT_GT(connectivityBits, 0.0);
+    }
+    if (std::string(c.name).find("coincident") != std::string::npos) EXPECT_GT(mine.size(), size_t(h.depth()));
+
+    ASSERT_GE(decoder.chunks().size(), 2u);
+    const ChunkInfo& middle = decoder.chunks()[decoder.chunks().size() / 2];
+    Decoder prefix(measuring);
+    ASSERT_TRUE(prefix.push(encoded.bytes.data(), middle.offset).ok());
+    const std::vector<LevelCost> completed = prefix.cost().levels;
+    EXPECT_LT(completed.size(), mine.size());
+    EXPECT_EQ(completed.size(), size_t(prefix.progress().level));
+    for (size_t l = 0; l < completed.size(); ++l) EXPECT_EQ(completed[l].geometryBits, mine[l].geometryBits);
+  }
 }
 
 TEST(Stream, TruncatedStreamsAreReportedByFinish) {

@@ -142,11 +142,25 @@ struct EncodeOptions {
   std::function<void(const EncodeProgress&)> progress;
 };
 
+// What the splits of one kd-tree level coded, in bits (CodingCost::levels).
+struct LevelCost {
+  // The axis the level halves its cells along (0..2), or -1 past the
+  // geometric levels, where cells of coincident vertices split in halves.
+  int axis = 0;
+  uint32_t cells = 0;  // cells the level split: the model's vertices before it
+  double geometryBits = 0;
+  double connectivityBits = 0;
+};
+
 // Information content of what a stream codes, in bits: the sum of -log2(p)
 // over every coded symbol, split by what the symbol describes.
 struct CodingCost {
   double geometryBits = 0;
   double connectivityBits = 0;
+  // The same by kd-tree level, coarse to fine: where the bits of a model go,
+  // and so how many a coarser quantization or a prefix of the stream would
+  // keep. The decoder lists the levels it has completed.
+  std::vector<LevelCost> levels;
 };
 
 // Input simplices the encoder dropped, per dimension. A complex holds a
