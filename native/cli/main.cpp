@@ -401,7 +401,7 @@ int main(int argc, char** argv) {
   info->add_flag("--json", infoJson, "Machine-readable output (lists the levels' bits)");
   bool infoLevels = false;
   info->add_flag("--levels", infoLevels,
-                 "Bits per vertex of every kd-tree level, with the cell size it reaches and the bytes it takes");
+                 "Bits per vertex of every kd-tree level, with the cell side it reaches and the bytes it takes");
 
   try {
     app.parse(argc, argv);

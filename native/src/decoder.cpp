@@ -246,7 +246,6 @@ struct Decoder::State {
     levelCells = uint32_t(cells.size() + singleLevelEnd - singleCursor);
   }
 
-
   // Appends the maximal simplices of the current complex, oriented, and its
   // isolated vertices.
   void appendSimplices(Complex& out) const {
