@@ -1,6 +1,8 @@
 // kdmesh command-line tool: encode, decode and inspect .kdm streams.
 #include <CLI/CLI.hpp>
 
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cinttypes>
@@ -211,17 +213,6 @@ std::string jsonNumber(double v) {
   return buffer;
 }
 
-// The largest side of a cell after `level`, in model units: each level
-// halves its axis, from 2^axisBits grid steps (grid streams only).
-double cellSideAfter(const kdmesh::Header& h, const std::vector<kdmesh::LevelCost>& levels, size_t level) {
-  std::array<int, 3> halvings{};
-  for (size_t l = 0; l <= level; ++l)
-    if (levels[l].axis >= 0) ++halvings[size_t(levels[l].axis)];
-  double side = 0;
-  for (int a = 0; a < 3; ++a) side = std::max(side, std::ldexp(h.step, h.axisBits(a) - halvings[size_t(a)]));
-  return side;
-}
-
 int runInfo(const std::string& input, bool json, bool perLevel) {
   std::vector<uint8_t> bytes;
   std::string error;
@@ -332,11 +323,16 @@ int runInfo(const std::string& input, bool json, bool perLevel) {
     std::printf("  %5s %4s %10s %12s %9s %12s %10s\n", "level", "axis", "cells", "cell side", "geometry",
                 "connectivity", "bytes");
     double bitsSoFar = 0;
+    // Each level halves its axis's cells, from 2^axisBits grid steps.
+    std::array<int, 3> bitsLeft{h.axisBits(0), h.axisBits(1), h.axisBits(2)};
     for (size_t i = 0; i < cost.levels.size(); ++i) {
       const kdmesh::LevelCost& level = cost.levels[i];
       bitsSoFar += level.geometryBits + level.connectivityBits;
+      if (level.axis >= 0) --bitsLeft[size_t(level.axis)];
       char side[32] = "-";
-      if (grid) std::snprintf(side, sizeof side, "%.4g", cellSideAfter(h, cost.levels, i));
+      if (grid)
+        std::snprintf(side, sizeof side, "%.4g",
+                      std::ldexp(h.step, *std::max_element(bitsLeft.begin(), bitsLeft.end())));
       std::printf("  %5zu %4s %10u %12s %9.3f %12.3f %10.0f\n", i,
                   level.axis < 0 ? "-" : level.axis == 0 ? "x" : level.axis == 1 ? "y" : "z", level.cells, side,
                   level.geometryBits / n, level.connectivityBits / n, double(h.headerBytes) + bitsSoFar / 8);

@@ -68,7 +68,6 @@ struct Decoder::State {
   std::vector<Cell> cells, children, singles, newSingles;
   size_t cursor = 0, singleCursor = 0, singleLevelEnd = 0;
   int level = 0;
-  uint32_t levelCells = 1;  // cells the level splits
   LevelCostTally levelCosts;
 
   // Connectivity: the complex on the current cells. Levels past the last
@@ -225,8 +224,10 @@ struct Decoder::State {
   }
 
   void nextLevel() {
+    // The level split its cells and, at geometric levels, its one-vertex cells.
     if (options.measureCost)
-      levelCosts.close(*schedule, level, levelCells, coder.cost(), cost.connectivityBits, cost.levels);
+      levelCosts.close(*schedule, level, uint32_t(cells.size() + (level < schedule->levels ? singleLevelEnd : 0)),
+                       coder.cost(), cost.connectivityBits, cost.levels);
     // Merge from the back, so that each one-vertex cell moves once.
     size_t old = singles.size(), out = old + newSingles.size();
     singles.resize(out);
@@ -243,7 +244,6 @@ struct Decoder::State {
     // Past the geometric levels one-vertex cells are final.
     singleCursor = level < schedule->levels ? 0 : singles.size();
     singleLevelEnd = singles.size();
-    levelCells = uint32_t(cells.size() + singleLevelEnd - singleCursor);
   }
 
   // Appends the maximal simplices of the current complex, oriented, and its

@@ -114,8 +114,8 @@ class ChunkWriter {
 // kNoSimplex for a one-sided split), placed(id, prefix, level) for each
 // non-empty half of a geometric split, single(level, parentOneSided,
 // inFirstHalf, id) for one-vertex cells, named(keyIndex, id) when a vertex
-// gets its final id, splitDone() after each split, and levelDone(level)
-// after the last split of each level.
+// gets its final id, splitDone() after each split, and levelDone(level,
+// cells) after the last split of each level, whose cells it counts.
 template <class Visitor>
 void traverseKdTree(const std::vector<KdKey>& keys, const SplitSchedule& schedule,
                     bool coincidentLevels, Visitor&& visitor) {
@@ -184,7 +184,7 @@ void traverseKdTree(const std::vector<KdKey>& keys, const SplitSchedule& schedul
       single.parentOneSided = true;
       visitor.splitDone();
     }
-    visitor.levelDone(level);
+    visitor.levelDone(level, uint32_t(cells.size() + singleLevelEnd));
     std::inplace_merge(singles.begin(), singles.begin() + std::ptrdiff_t(oldSingles),
                        singles.end(), [](const Single& a, const Single& b) { return a.key < b.key; });
     std::swap(cells, children);
@@ -242,7 +242,7 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
       void single(int, bool, bool, uint32_t) {}
       void named(uint32_t key, uint32_t id) { ids[vertexOfKey[key]] = id; }
       void splitDone() {}
-      void levelDone(int) {}
+      void levelDone(int, uint32_t) {}
     } naming{ids, splits, order.vertices};
     traverseKdTree(order.keys, schedule, true, naming);
     SimplexStore store;
@@ -285,7 +285,6 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
     std::function<void(const char*, double)> report;
     std::vector<LevelCost>& levels;
     int reportedLevel = -1;
-    uint32_t levelCells = 0;
     LevelCostTally levelCosts{};
 
     void cell(int level, bool geometric, uint32_t population, uint32_t firstHalf,
@@ -294,7 +293,6 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
         reportedLevel = level;
         report("code", double(level) / double(schedule.levels + 1));
       }
-      ++levelCells;
       if (geometric)
         counts.code(coder, population, level, parentOneSided, firstHalf,
                     connectivity ? predictor.countContext(kept, level) : CountContext{});
@@ -310,7 +308,6 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
       if (connectivity) predictor.place(id, prefix, level);
     }
     void single(int level, bool parentOneSided, bool inFirstHalf, uint32_t id) {
-      ++levelCells;
       if (connectivity)
         predictor.codeSingle(coder, counts, id, level, parentOneSided, inFirstHalf);
       else
@@ -318,9 +315,8 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
     }
     void named(uint32_t, uint32_t) {}
     void splitDone() { chunks.splitDone(); }
-    void levelDone(int level) {
-      levelCosts.close(schedule, level, levelCells, coder.cost(), connectivityBits, levels);
-      levelCells = 0;
+    void levelDone(int level, uint32_t cells) {
+      levelCosts.close(schedule, level, cells, coder.cost(), connectivityBits, levels);
     }
   } coding{header, schedule, counts, coder, chunks, splitter, forward, predictor, records, splitIndex,
            connectivityBits, connectivity, report, result.cost.levels};

@@ -194,7 +194,7 @@ PositionPredictor::PositionPredictor(const SplitSchedule& schedule, const Simple
       planeModels_(size_t(kOutsideClasses) * kScaleClasses * kTiltClasses * kPlaneBuckets),
       centroidModels_(size_t(kValenceClasses) * kScaleClasses * kCentroidBuckets),
       parallelogramModels_(size_t(kPlaneBuckets) * kSpreadClasses * kParallelogramBuckets),
-      refinementModels_(size_t(CountContext::kRefinementClasses) * 4 * 2),
+      refinementModels_(kRefinementModels),
       mixer_(kElongationGroups * kScaleClasses * kAgreementClasses, mixerPriors(MixerFamily::OneVertexSplits)),
       parallelogramMixer_(kParallelogramBuckets, mixerPriors(MixerFamily::OneVertexByParallelogram)),
       planeAndCentroidMixer_(kCentroidBuckets * kPlaneBuckets, mixerPriors(MixerFamily::OneVertexByPlaneAndCentroid)) {
@@ -218,8 +218,7 @@ PositionPredictor::PositionPredictor(const SplitSchedule& schedule, const Simple
   primeModels(ModelFamily::OneVertexByPlane, planeModels_.data());
   primeModels(ModelFamily::OneVertexByCentroid, centroidModels_.data());
   primeModels(ModelFamily::OneVertexByParallelogram, parallelogramModels_.data());
-  static_assert(size_t(CountContext::kRefinementClasses) * 4 * 2 ==
-                kFamilySize[int(ModelFamily::OneVertexByRefinement)]);
+  static_assert(kRefinementModels == kFamilySize[int(ModelFamily::OneVertexByRefinement)]);
   primeModels(ModelFamily::OneVertexByRefinement, refinementModels_.data());
   widths_.resize(size_t(schedule.levels) + 1);
   for (size_t level = 0; level < widths_.size(); ++level)

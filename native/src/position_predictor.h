@@ -269,6 +269,8 @@ class PositionPredictor {
     BitModel parallelogramOdds;
   };
   bool contextsOf(uint32_t vertex, int level, SingleContexts& contexts);
+  // One-vertex refinement models: the class with far halves, by tilt.
+  static constexpr size_t kRefinementModels = size_t(CountContext::kRefinementClasses) * 4 * 2;
   // The neighbourhood of a vertex in no simplex: its proxy as its one
   // neighbour, with the plane of the proxy's own neighbourhood (no
   // parallelograms: they predict the proxy). The proxy is the first vertex
