@@ -111,19 +111,44 @@ void primeModels(ModelFamily family, BitModel* models) {
       codedFamily(kEdgeCodeByRunPriors), codedFamily(kVertexCodePriors),
       codedFamily(kOneVertexByRefinementPriors), codedFamily(kCellCountByRefinementPriors)};
   const CodedFamily& coded = kPriors[int(family)];
-  auto prime = [&models](uint16_t prior) {
-    models->fast = models->slow = prior;
+  for (const uint8_t code : expandPriorCodes(coded.values, coded.size)) {
+    models->fast = models->slow = priorOfCode(code);
     models->seen = kPriorObservations;
     ++models;
-  };
-  for (size_t i = 0; i < coded.size; ++i) {
-    if (coded.values[i] == kPriorRunMarker) {
-      for (size_t run = runLength(coded.values, i); run > 0; --run) prime(uint16_t(kProbabilityOne / 2));
-      i += 2;
+  }
+}
+
+std::vector<uint8_t> runLengthCodePriors(const std::vector<uint8_t>& codes) {
+  std::vector<uint8_t> coded;
+  constexpr size_t kNoRun = SIZE_MAX, kLongestRun = 0xffff;
+  size_t runAt = kNoRun;  // the marker of the run coded ends in
+  for (const uint8_t code : codes) {
+    if (code != kHalfPriorCode) {
+      runAt = kNoRun;
+      coded.push_back(code);
+    } else if (runAt != kNoRun && runLength(coded.data(), runAt) < kLongestRun) {
+      const size_t length = runLength(coded.data(), runAt) + 1;
+      coded[runAt + 1] = uint8_t(length & 0xff);
+      coded[runAt + 2] = uint8_t(length >> 8);
     } else {
-      prime(priorOfCode(coded.values[i]));
+      runAt = coded.size();
+      coded.insert(coded.end(), {kPriorRunMarker, 1, 0});
     }
   }
+  return coded;
+}
+
+std::vector<uint8_t> expandPriorCodes(const uint8_t* coded, size_t size) {
+  std::vector<uint8_t> codes;
+  for (size_t i = 0; i < size; ++i) {
+    if (coded[i] == kPriorRunMarker) {
+      codes.insert(codes.end(), runLength(coded, i), kHalfPriorCode);
+      i += 2;
+    } else {
+      codes.push_back(coded[i]);
+    }
+  }
+  return codes;
 }
 
 }  // namespace kdmesh

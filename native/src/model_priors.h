@@ -14,6 +14,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <vector>
 
 #include "range_coder.h"
 
@@ -44,6 +45,11 @@ constexpr std::array<size_t, kModelFamilies> kFamilySize = {9000, 11760, 3042, 3
 // them is kPriorRunMarker followed by the run's length in two bytes, low
 // byte first. Prior codes are 1..255, so the marker is no prior.
 constexpr uint8_t kPriorRunMarker = 0;
+// The run-length coding of a family's prior codes (one per model) as
+// model_priors.inc holds it: the trainer writes it, primeModels() reads
+// it back with expandPriorCodes().
+std::vector<uint8_t> runLengthCodePriors(const std::vector<uint8_t>& codes);
+std::vector<uint8_t> expandPriorCodes(const uint8_t* coded, size_t size);
 
 // Priors are stored one byte each, as their logit: code q stands for
 // P(0) = squash((q − 128) · 16) · 8 in units of 2^-15 (mixer.h's logistic

@@ -124,28 +124,15 @@ int main(int argc, char** argv) {
   for (int f = 0; f < kdmesh::kModelFamilies; ++f) {
     std::vector<kdmesh::BitModel> compiled(kdmesh::kFamilySize[size_t(f)]);
     kdmesh::primeModels(kdmesh::ModelFamily(f), compiled.data());
-    // One byte per prior (model_priors.h), and a run of models at 1/2 as
-    // the marker and the run's length in two bytes.
-    std::vector<int> coded;
-    size_t runAt = 0;  // of the current run's marker, if coded ends in a run
+    std::vector<uint8_t> codes;
     for (size_t m = 0; m < kdmesh::kFamilySize[size_t(f)]; ++m) {
       const double w = weight[size_t(f)][m];
       const int prior = !retrain[size_t(f)] ? int(compiled[m].slow)
                         : w >= kMinWeight ? int(sum[size_t(f)][m] / w + 0.5)
                                         : int(kdmesh::kProbabilityOne / 2);
-      const int code = kdmesh::priorCode(uint32_t(prior));
-      const bool inRun = coded.size() >= 3 && runAt == coded.size() - 3;
-      const int runLength = inRun ? coded[runAt + 1] | coded[runAt + 2] << 8 : 0;
-      if (code == kdmesh::kHalfPriorCode && inRun && runLength < 0xffff) {
-        coded[runAt + 1] = (runLength + 1) & 0xff;
-        coded[runAt + 2] = (runLength + 1) >> 8;
-      } else if (code == kdmesh::kHalfPriorCode) {
-        runAt = coded.size();
-        coded.insert(coded.end(), {kdmesh::kPriorRunMarker, 1, 0});
-      } else {
-        coded.push_back(code);
-      }
+      codes.push_back(kdmesh::priorCode(uint32_t(prior)));
     }
+    const std::vector<uint8_t> coded = kdmesh::runLengthCodePriors(codes);
     std::fprintf(out, "constexpr uint8_t %s[%zu] = {", kNames[f], coded.size());
     for (size_t i = 0; i < coded.size(); ++i)
       std::fprintf(out, "%s%s%d", i ? "," : "", i % 16 == 0 ? "\n    " : " ", coded[i]);

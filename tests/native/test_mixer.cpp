@@ -88,6 +88,31 @@ TEST(ModelPriors, OneByteCodesRoundTrip) {
   EXPECT_GT(priorOfCode(priorCode(uint32_t(kProbabilityOne * 0.999))), uint32_t(kProbabilityOne * 0.995));
 }
 
+// Runs of 1/2 anywhere: first, after literals (three literals once read as
+// a run and had their bytes overwritten), last, and longer than one run can
+// hold. Each run costs three bytes.
+TEST(ModelPriors, RunLengthCodingRoundTrips) {
+  constexpr uint8_t kHalf = kHalfPriorCode;
+  const std::vector<std::vector<uint8_t>> families = {
+      {},
+      {kHalf},
+      {7, 9, 11, kHalf, kHalf, 13},
+      {kHalf, kHalf, 5, kHalf, 6, 7, 8, kHalf, kHalf, kHalf},
+      {1, 255, kHalf - 1, kHalf + 1},
+  };
+  for (const std::vector<uint8_t>& codes : families) {
+    const std::vector<uint8_t> coded = runLengthCodePriors(codes);
+    EXPECT_EQ(expandPriorCodes(coded.data(), coded.size()), codes);
+  }
+  EXPECT_EQ(runLengthCodePriors({7, 9, 11, kHalf, kHalf, 13}),
+            (std::vector<uint8_t>{7, 9, 11, kPriorRunMarker, 2, 0, 13}));
+  std::vector<uint8_t> longRun(70000, kHalf);
+  longRun.push_back(3);
+  const std::vector<uint8_t> coded = runLengthCodePriors(longRun);
+  EXPECT_EQ(coded, (std::vector<uint8_t>{kPriorRunMarker, 0xff, 0xff, kPriorRunMarker, (70000 - 0xffff) & 0xff, (70000 - 0xffff) >> 8, 3}));
+  EXPECT_EQ(expandPriorCodes(coded.data(), coded.size()), longRun);
+}
+
 // A coder that keeps the probability it was given.
 struct ProbeCoder {
   uint32_t probabilityOfZero = 0;
