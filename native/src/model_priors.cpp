@@ -29,21 +29,11 @@ static_assert(std::size(kOneVertexByParallelogramMixerPriors) == kMixerSets[2] *
 static_assert(std::size(kOneVertexByPlaneAndCentroidMixerPriors) == kMixerSets[3] * kMixerInputs[3]);
 static_assert(std::size(kEdgeCodeMixerPriors) == kMixerSets[4] * kMixerInputs[4]);
 
-// The length of the run whose marker is at coded[i].
-constexpr size_t runLength(const uint8_t* coded, size_t i) { return size_t(coded[i + 1]) | size_t(coded[i + 2]) << 8; }
-
 // How many models a run-length coded family primes.
 template <size_t kCoded>
 constexpr size_t expandedSize(const uint8_t (&coded)[kCoded]) {
   size_t models = 0;
-  for (size_t i = 0; i < kCoded; ++i) {
-    if (coded[i] == kPriorRunMarker) {
-      models += runLength(coded, i);
-      i += 2;
-    } else {
-      ++models;
-    }
-  }
+  forEachPriorCode(coded, kCoded, [&models](uint8_t) { ++models; });
   return models;
 }
 
@@ -111,11 +101,11 @@ void primeModels(ModelFamily family, BitModel* models) {
       codedFamily(kEdgeCodeByRunPriors), codedFamily(kVertexCodePriors),
       codedFamily(kOneVertexByRefinementPriors), codedFamily(kCellCountByRefinementPriors)};
   const CodedFamily& coded = kPriors[int(family)];
-  for (const uint8_t code : expandPriorCodes(coded.values, coded.size)) {
+  forEachPriorCode(coded.values, coded.size, [&models](uint8_t code) {
     models->fast = models->slow = priorOfCode(code);
     models->seen = kPriorObservations;
     ++models;
-  }
+  });
 }
 
 std::vector<uint8_t> runLengthCodePriors(const std::vector<uint8_t>& codes) {
@@ -126,8 +116,8 @@ std::vector<uint8_t> runLengthCodePriors(const std::vector<uint8_t>& codes) {
     if (code != kHalfPriorCode) {
       runAt = kNoRun;
       coded.push_back(code);
-    } else if (runAt != kNoRun && runLength(coded.data(), runAt) < kLongestRun) {
-      const size_t length = runLength(coded.data(), runAt) + 1;
+    } else if (runAt != kNoRun && priorRunLength(coded.data(), runAt) < kLongestRun) {
+      const size_t length = priorRunLength(coded.data(), runAt) + 1;
       coded[runAt + 1] = uint8_t(length & 0xff);
       coded[runAt + 2] = uint8_t(length >> 8);
     } else {
@@ -136,19 +126,6 @@ std::vector<uint8_t> runLengthCodePriors(const std::vector<uint8_t>& codes) {
     }
   }
   return coded;
-}
-
-std::vector<uint8_t> expandPriorCodes(const uint8_t* coded, size_t size) {
-  std::vector<uint8_t> codes;
-  for (size_t i = 0; i < size; ++i) {
-    if (coded[i] == kPriorRunMarker) {
-      codes.insert(codes.end(), runLength(coded, i), kHalfPriorCode);
-      i += 2;
-    } else {
-      codes.push_back(coded[i]);
-    }
-  }
-  return codes;
 }
 
 }  // namespace kdmesh

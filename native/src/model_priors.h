@@ -45,11 +45,6 @@ constexpr std::array<size_t, kModelFamilies> kFamilySize = {9000, 11760, 3042, 3
 // them is kPriorRunMarker followed by the run's length in two bytes, low
 // byte first. Prior codes are 1..255, so the marker is no prior.
 constexpr uint8_t kPriorRunMarker = 0;
-// The run-length coding of a family's prior codes (one per model) as
-// model_priors.inc holds it: the trainer writes it, primeModels() reads
-// it back with expandPriorCodes().
-std::vector<uint8_t> runLengthCodePriors(const std::vector<uint8_t>& codes);
-std::vector<uint8_t> expandPriorCodes(const uint8_t* coded, size_t size);
 
 // Priors are stored one byte each, as their logit: code q stands for
 // P(0) = squash((q − 128) · 16) · 8 in units of 2^-15 (mixer.h's logistic
@@ -60,6 +55,26 @@ std::vector<uint8_t> expandPriorCodes(const uint8_t* coded, size_t size);
 constexpr uint8_t kHalfPriorCode = 128;
 uint8_t priorCode(uint32_t probabilityOfZero);
 uint16_t priorOfCode(uint8_t code);
+
+// The run-length coding of a family's prior codes (one per model) as
+// model_priors.inc holds it, written by the trainer.
+std::vector<uint8_t> runLengthCodePriors(const std::vector<uint8_t>& codes);
+// The length of the run whose marker is at coded[marker].
+constexpr size_t priorRunLength(const uint8_t* coded, size_t marker) {
+  return size_t(coded[marker + 1]) | size_t(coded[marker + 2]) << 8;
+}
+// Reads the coding back: visit(code) for each model in turn.
+template <class Visit>
+constexpr void forEachPriorCode(const uint8_t* coded, size_t size, Visit&& visit) {
+  for (size_t i = 0; i < size; ++i) {
+    if (coded[i] == kPriorRunMarker) {
+      for (size_t run = priorRunLength(coded, i); run > 0; --run) visit(kHalfPriorCode);
+      i += 2;
+    } else {
+      visit(coded[i]);
+    }
+  }
+}
 
 // As many observations as a prior is worth: the slow estimator then starts
 // at a moderate rate and still follows the model at hand.

@@ -100,17 +100,19 @@ TEST(ModelPriors, RunLengthCodingRoundTrips) {
       {kHalf, kHalf, 5, kHalf, 6, 7, 8, kHalf, kHalf, kHalf},
       {1, 255, kHalf - 1, kHalf + 1},
   };
-  for (const std::vector<uint8_t>& codes : families) {
-    const std::vector<uint8_t> coded = runLengthCodePriors(codes);
-    EXPECT_EQ(expandPriorCodes(coded.data(), coded.size()), codes);
-  }
+  auto expand = [](const std::vector<uint8_t>& coded) {
+    std::vector<uint8_t> codes;
+    forEachPriorCode(coded.data(), coded.size(), [&codes](uint8_t code) { codes.push_back(code); });
+    return codes;
+  };
+  for (const std::vector<uint8_t>& codes : families) EXPECT_EQ(expand(runLengthCodePriors(codes)), codes);
   EXPECT_EQ(runLengthCodePriors({7, 9, 11, kHalf, kHalf, 13}),
             (std::vector<uint8_t>{7, 9, 11, kPriorRunMarker, 2, 0, 13}));
   std::vector<uint8_t> longRun(70000, kHalf);
   longRun.push_back(3);
   const std::vector<uint8_t> coded = runLengthCodePriors(longRun);
   EXPECT_EQ(coded, (std::vector<uint8_t>{kPriorRunMarker, 0xff, 0xff, kPriorRunMarker, (70000 - 0xffff) & 0xff, (70000 - 0xffff) >> 8, 3}));
-  EXPECT_EQ(expandPriorCodes(coded.data(), coded.size()), longRun);
+  EXPECT_EQ(expand(coded), longRun);
 }
 
 // A coder that keeps the probability it was given.
