@@ -108,10 +108,11 @@ TEST(ModelPriors, RunLengthCodingRoundTrips) {
   for (const std::vector<uint8_t>& codes : families) EXPECT_EQ(expand(runLengthCodePriors(codes)), codes);
   EXPECT_EQ(runLengthCodePriors({7, 9, 11, kHalf, kHalf, 13}),
             (std::vector<uint8_t>{7, 9, 11, kPriorRunMarker, 2, 0, 13}));
-  std::vector<uint8_t> longRun(70000, kHalf);
+  constexpr size_t kLong = 70000, kRest = kLong - 0xffff;
+  std::vector<uint8_t> longRun(kLong, kHalf);
   longRun.push_back(3);
   const std::vector<uint8_t> coded = runLengthCodePriors(longRun);
-  EXPECT_EQ(coded, (std::vector<uint8_t>{kPriorRunMarker, 0xff, 0xff, kPriorRunMarker, (70000 - 0xffff) & 0xff, (70000 - 0xffff) >> 8, 3}));
+  EXPECT_EQ(coded, (std::vector<uint8_t>{kPriorRunMarker, 0xff, 0xff, kPriorRunMarker, kRest & 0xff, kRest >> 8, 3}));
   EXPECT_EQ(expand(coded), longRun);
 }
 
