@@ -299,6 +299,70 @@ struct Decoder::State {
     return uint32_t(children.size() + cells.size() - cursor + singles.size() + newSingles.size());
   }
 
+  // The vertices of an unfinished complex where their neighbours say they
+  // lie (CoarsePlacement::Predicted): each cell centre moved along the
+  // vertex's normal (the sum of its triangles' oriented area vectors) onto
+  // the plane through its neighbours' centroid, then clamped to the cell.
+  // Moving along the normal alone keeps the surface from shrinking
+  // tangentially, as a plain neighbour average would at boundaries and
+  // tips. A vertex in no triangle goes to its neighbours' centroid; one in
+  // no edge stays at its cell's centre. Float32 streams place in float
+  // values, whose cells are intervals too.
+  void placeOnNeighbourPlanes(std::vector<float>& positions) const {
+    const size_t n = nextVertex;
+    std::vector<double> centre(n * 3), low(n * 3), high(n * 3), sum(n * 3, 0.0), normal(n * 3, 0.0);
+    std::vector<uint32_t> degree(n, 0);
+    forEachCurrentCell([&](const Cell& cell, int cellLevel) {
+      for (int a = 0; a < 3; ++a) {
+        uint32_t lo, hi;
+        cellRange(cell, cellLevel, a, lo, hi);
+        const size_t i = size_t(cell.vertex) * 3 + size_t(a);
+        low[i] = dequantizer->position(a, lo, lo);
+        high[i] = dequantizer->position(a, hi, hi);
+        centre[i] = dequantizer->position(a, lo, hi);
+      }
+    });
+    for (uint32_t edge = 0; edge < store.size(1); ++edge) {
+      if (!(store.flags(1, edge) & SimplexStore::kAlive)) continue;
+      const uint32_t* v = store.vertices(1, edge);
+      const size_t i = size_t(v[0]) * 3, j = size_t(v[1]) * 3;
+      for (size_t a = 0; a < 3; ++a) {
+        sum[i + a] += centre[j + a];
+        sum[j + a] += centre[i + a];
+      }
+      ++degree[v[0]];
+      ++degree[v[1]];
+    }
+    for (uint32_t triangle = 0; triangle < store.size(2); ++triangle) {
+      const uint8_t flags = store.flags(2, triangle);
+      if (!(flags & SimplexStore::kAlive)) continue;
+      const uint32_t* v = store.vertices(2, triangle);
+      const double* p = &centre[size_t(v[0]) * 3];
+      const double* q = &centre[size_t(v[1]) * 3];
+      const double* r = &centre[size_t(v[2]) * 3];
+      const double u[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]}, w[3] = {r[0] - p[0], r[1] - p[1], r[2] - p[2]};
+      const double sign = flags & SimplexStore::kFlipped ? -1.0 : 1.0;
+      const double area[3] = {sign * (u[1] * w[2] - u[2] * w[1]), sign * (u[2] * w[0] - u[0] * w[2]),
+                              sign * (u[0] * w[1] - u[1] * w[0])};
+      for (int k = 0; k < 3; ++k)
+        for (size_t a = 0; a < 3; ++a) normal[size_t(v[k]) * 3 + a] += area[a];
+    }
+    positions.resize(n * 3);
+    for (size_t v = 0; v < n; ++v) {
+      const size_t i = v * 3;
+      double target[3] = {centre[i], centre[i + 1], centre[i + 2]};
+      if (degree[v] > 0) {
+        double offset[3];
+        for (size_t a = 0; a < 3; ++a) offset[a] = sum[i + a] / double(degree[v]) - centre[i + a];
+        const double* m = &normal[i];
+        const double squared = m[0] * m[0] + m[1] * m[1] + m[2] * m[2];
+        const double along = squared > 0 ? (m[0] * offset[0] + m[1] * offset[1] + m[2] * offset[2]) / squared : 0;
+        for (size_t a = 0; a < 3; ++a) target[a] += squared > 0 ? along * m[a] : offset[a];
+      }
+      for (size_t a = 0; a < 3; ++a) positions[i + a] = float(std::clamp(target[a], low[i + a], high[i + a]));
+    }
+  }
+
   // Replaces `out` with the model at the current level (Decoder::snapshot);
   // once complete, `takeFinal` moves the simplex lists out instead of
   // copying them, for decode(), whose decoder is discarded next (the copy
@@ -308,6 +372,11 @@ struct Decoder::State {
     if (!hasHeader) return;
     const bool finished = complete();
     if (connectivity) {
+      if (!finished && options.coarsePlacement == CoarsePlacement::Predicted) {
+        placeOnNeighbourPlanes(out.positions);
+        appendSimplices(out);
+        return;
+      }
       out.positions.resize(size_t(nextVertex) * 3);
       forEachCurrentCell([&](const Cell& cell, int cellLevel) {
         for (int a = 0; a < 3; ++a) {
@@ -470,6 +539,8 @@ double Decoder::errorBound() const {
   const State& s = *state_;
   if (!s.hasHeader) return INFINITY;
   const double halfStep = s.header.quantization == Quantization::Grid ? s.header.step * 0.5 : 0;
+  // A predicted vertex may lie anywhere in its cell; a centre, in its middle.
+  const double share = s.connectivity && s.options.coarsePlacement == CoarsePlacement::Predicted ? 1.0 : 0.5;
   double worst = 0;
   s.forEachCurrentCell([&](const Cell& cell, int cellLevel) {
     double squared = 0;
@@ -477,7 +548,7 @@ double Decoder::errorBound() const {
       uint32_t lo, hi;
       s.cellRange(cell, cellLevel, a, lo, hi);
       const double half =
-          (double(s.dequantizer->position(a, hi, hi)) - double(s.dequantizer->position(a, lo, lo))) * 0.5 +
+          (double(s.dequantizer->position(a, hi, hi)) - double(s.dequantizer->position(a, lo, lo))) * share +
           halfStep;
       squared += half * half;
     }

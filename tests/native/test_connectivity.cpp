@@ -202,6 +202,61 @@ TEST(Connectivity, BadIndicesAreRejected) {
   EXPECT_NE(r.status.message.find("triangle 0 refers to vertex 7"), std::string::npos) << r.status.message;
 }
 
+// Coarse vertices placed on their neighbours' planes stay in their cells
+// (within the decoder's error bound of every input vertex they stand for),
+// lie closer to the vertices they stand for than cell centres, on the
+// whole, and leave the complete model exact.
+TEST(CoarsePlacement, PredictedVerticesStayInTheirCellsAndComeCloserToTheModel) {
+  for (const bool exactFloats : {false, true}) {
+    SCOPED_TRACE(exactFloats ? "float32" : "12-bit grid");
+    EncodeOptions o;
+    o.bits = 12;
+    o.exact = exactFloats;
+    o.chunkBytes = 512;
+    const EncodeResult encoded = encode(sphereMesh(60, 120), o);
+    ASSERT_TRUE(encoded.status.ok()) << encoded.status.message;
+    DecoderOptions centres;
+    centres.coarsePlacement = CoarsePlacement::CellCentre;
+    Decoder full;
+    ASSERT_TRUE(full.push(encoded.bytes.data(), encoded.bytes.size()).ok());
+    const Complex final = full.snapshot();
+    const std::vector<uint32_t> parents = full.vertexParents();
+    double predictedError = 0, centreError = 0;
+    size_t prefixes = 0;
+    for (const ChunkInfo& chunk : full.chunks()) {
+      Decoder predicted, centred(centres);
+      ASSERT_TRUE(predicted.push(encoded.bytes.data(), chunk.offset).ok());
+      ASSERT_TRUE(centred.push(encoded.bytes.data(), chunk.offset).ok());
+      if (!predicted.hasHeader()) continue;
+      const Complex p = predicted.snapshot(), c = centred.snapshot();
+      ASSERT_EQ(p.vertexCount(), c.vertexCount());
+      EXPECT_EQ(p.triangles, c.triangles);
+      const double bound = predicted.errorBound();
+      EXPECT_LE(bound, 2 * centred.errorBound() * (1 + 1e-9));
+      const uint32_t count = uint32_t(p.vertexCount());
+      for (uint32_t v = 0; v < final.vertexCount(); ++v) {
+        uint32_t a = v;
+        while (a >= count) a = parents[a];
+        double squaredToPredicted = 0, squaredToCentre = 0;
+        for (size_t k = 0; k < 3; ++k) {
+          const double exactCoordinate = final.positions[3 * v + k];
+          squaredToPredicted += std::pow(exactCoordinate - p.positions[3 * a + k], 2);
+          squaredToCentre += std::pow(exactCoordinate - c.positions[3 * a + k], 2);
+        }
+        ASSERT_LE(std::sqrt(squaredToPredicted), bound * (1 + 1e-6) + 1e-9) << "vertex " << v;
+        predictedError += std::sqrt(squaredToPredicted);
+        centreError += std::sqrt(squaredToCentre);
+      }
+      ++prefixes;
+    }
+    EXPECT_GT(prefixes, 10u);
+    EXPECT_LT(predictedError, centreError);
+    Decoder completeCentred(centres);
+    ASSERT_TRUE(completeCentred.push(encoded.bytes.data(), encoded.bytes.size()).ok());
+    EXPECT_EQ(completeCentred.snapshot().positions, final.positions);
+  }
+}
+
 TEST(Connectivity, EveryChunkPrefixIsTheProjectionOfTheInput) {
   EncodeOptions o = exact();
   o.chunkBytes = 64;

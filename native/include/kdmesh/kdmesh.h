@@ -233,8 +233,20 @@ struct DecoderLimits {
   uint32_t maxSimplices = 1u << 28;
 };
 
+// Where snapshot() puts the vertex of a cell that is not yet a single grid
+// point, before the stream is complete.
+enum class CoarsePlacement {
+  // On the plane of its neighbours in the complex, clamped to its cell: a
+  // coarse surface looks like the model rather than like voxels. Streams
+  // without simplices place at cell centres.
+  Predicted,
+  // At the centre of its cell.
+  CellCentre,
+};
+
 struct DecoderOptions {
   DecoderLimits limits;
+  CoarsePlacement coarsePlacement = CoarsePlacement::Predicted;
   // Accumulate CodingCost while decoding (costs a little speed).
   bool measureCost = false;
 };
@@ -295,17 +307,20 @@ class Decoder {
   // vertex can be traced to its ancestor at a coarser level.
   const std::vector<uint32_t>& vertexParents() const;
 
-  // The model at the current level: one vertex at the centre of every
-  // current kd-tree cell (clamped to the bounding box), or, once complete,
-  // every input vertex at its exact (quantized) position. Replaces `out`.
+  // The model at the current level: one vertex in every current kd-tree
+  // cell (clamped to the bounding box), placed as DecoderOptions::
+  // coarsePlacement says, or, once complete, every input vertex at its exact
+  // (quantized) position. Replaces `out`.
   // With connectivity, vertex v of the snapshot is vertex id v, and the
   // simplices are the maximal simplices of the current complex (the input
   // complex with every vertex replaced by its cell), oriented as the input
   // simplices they stand for.
   void snapshot(Complex& out) const;
   Complex snapshot() const;
-  // Half the diagonal of the largest current cell: no input vertex is
-  // farther than this from the snapshot vertex of its cell.
+  // No input vertex is farther than this from the snapshot vertex of its
+  // cell: half the diagonal of the largest current cell with cell-centre
+  // placement, the whole diagonal with predicted placement (which may put
+  // the vertex in a corner).
   double errorBound() const;
 
  private:
