@@ -246,6 +246,26 @@ struct Decoder::State {
     singleLevelEnd = singles.size();
   }
 
+  // Which edges are sides of a triangle, indexed by edge. Walks each
+  // vertex's triangles once, marking the vertices they hold, then its
+  // edges: an edge test by its own walk of the triangles around its first
+  // vertex costs one walk per edge, each a chain of cache misses on a
+  // large complex.
+  std::vector<bool> edgesInTriangles() const {
+    std::vector<bool> inTriangle(store.size(1), false);
+    std::vector<uint32_t> markedBy(nextVertex, kNoSimplex);
+    for (uint32_t a = 0; a < nextVertex; ++a) {
+      store.forEachIncident(2, a, [&](uint32_t triangle, uint32_t) {
+        const uint32_t* v = store.vertices(2, triangle);
+        for (int k = 0; k < 3; ++k) markedBy[v[k]] = a;
+      });
+      store.forEachIncident(1, a, [&](uint32_t edge, uint32_t position) {
+        if (markedBy[store.vertices(1, edge)[1 - position]] == a) inTriangle[edge] = true;
+      });
+    }
+    return inTriangle;
+  }
+
   // Appends the maximal simplices of the current complex, oriented, and its
   // isolated vertices.
   void appendSimplices(Complex& out) const {
@@ -259,10 +279,11 @@ struct Decoder::State {
       const bool finished = complete();
       if (finished && maximal == 0) continue;
       const bool testFaces = !finished || maximal != store.liveCount(d);
-      list.reserve(size_t(finished ? maximal : 0) * size_t(d + 1));
+      list.reserve(size_t(finished ? maximal : store.liveCount(d)) * size_t(d + 1));
+      const std::vector<bool> edgeIsFace = d == 1 && testFaces ? edgesInTriangles() : std::vector<bool>{};
       for (uint32_t simplex = 0; simplex < store.size(d); ++simplex) {
         if (!(store.flags(d, simplex) & SimplexStore::kAlive)) continue;
-        if (testFaces && store.isFace(d, simplex)) continue;
+        if (testFaces && (d == 1 ? bool(edgeIsFace[simplex]) : store.isFace(d, simplex))) continue;
         const uint32_t* v = store.vertices(d, simplex);
         const size_t at = list.size();
         list.insert(list.end(), v, v + d + 1);
@@ -310,7 +331,9 @@ struct Decoder::State {
   // values, whose cells are intervals too.
   void placeOnNeighbourPlanes(std::vector<float>& positions) const {
     const size_t n = nextVertex;
-    std::vector<double> centre(n * 3), low(n * 3), high(n * 3), sum(n * 3, 0.0), normal(n * 3, 0.0);
+    // Floats: the cells' bounds are floats, and the sums need no more for
+    // a picture (half the memory to touch).
+    std::vector<float> centre(n * 3), low(n * 3), high(n * 3), sum(n * 3, 0.0f), normal(n * 3, 0.0f);
     std::vector<uint32_t> degree(n, 0);
     forEachCurrentCell([&](const Cell& cell, int cellLevel) {
       for (int a = 0; a < 3; ++a) {
@@ -337,15 +360,15 @@ struct Decoder::State {
       const uint8_t flags = store.flags(2, triangle);
       if (!(flags & SimplexStore::kAlive)) continue;
       const uint32_t* v = store.vertices(2, triangle);
-      const double* p = &centre[size_t(v[0]) * 3];
-      const double* q = &centre[size_t(v[1]) * 3];
-      const double* r = &centre[size_t(v[2]) * 3];
+      const float* p = &centre[size_t(v[0]) * 3];
+      const float* q = &centre[size_t(v[1]) * 3];
+      const float* r = &centre[size_t(v[2]) * 3];
       const double u[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]}, w[3] = {r[0] - p[0], r[1] - p[1], r[2] - p[2]};
       const double sign = flags & SimplexStore::kFlipped ? -1.0 : 1.0;
       const double area[3] = {sign * (u[1] * w[2] - u[2] * w[1]), sign * (u[2] * w[0] - u[0] * w[2]),
                               sign * (u[0] * w[1] - u[1] * w[0])};
       for (int k = 0; k < 3; ++k)
-        for (size_t a = 0; a < 3; ++a) normal[size_t(v[k]) * 3 + a] += area[a];
+        for (size_t a = 0; a < 3; ++a) normal[size_t(v[k]) * 3 + a] += float(area[a]);
     }
     positions.resize(n * 3);
     for (size_t v = 0; v < n; ++v) {
@@ -354,12 +377,13 @@ struct Decoder::State {
       if (degree[v] > 0) {
         double offset[3];
         for (size_t a = 0; a < 3; ++a) offset[a] = sum[i + a] / double(degree[v]) - centre[i + a];
-        const double* m = &normal[i];
+        const double m[3] = {normal[i], normal[i + 1], normal[i + 2]};
         const double squared = m[0] * m[0] + m[1] * m[1] + m[2] * m[2];
         const double along = squared > 0 ? (m[0] * offset[0] + m[1] * offset[1] + m[2] * offset[2]) / squared : 0;
         for (size_t a = 0; a < 3; ++a) target[a] += squared > 0 ? along * m[a] : offset[a];
       }
-      for (size_t a = 0; a < 3; ++a) positions[i + a] = float(std::clamp(target[a], low[i + a], high[i + a]));
+      for (size_t a = 0; a < 3; ++a)
+        positions[i + a] = float(std::clamp(target[a], double(low[i + a]), double(high[i + a])));
     }
   }
 
