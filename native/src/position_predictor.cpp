@@ -175,7 +175,13 @@ namespace {
 uint16_t parallelogramOdds(const double offset, const double spread) {
   constexpr double kVariance = 0.15, kScale = 700;  // squared half widths; logistic units of 1/256
   const double logit = std::clamp(kScale * offset / std::sqrt(spread + kVariance), -2047.0, 2047.0);
-  const uint32_t p0 = uint32_t(Logistic::squash(int(std::lround(logit)))) << 3;
+  // Rounded half away from zero, as std::lround does, without its call:
+  // the logit is clamped far inside int's range, so the truncation is
+  // exact and so is the fraction it leaves.
+  int rounded = int(logit);
+  const double fraction = logit - rounded;
+  rounded += (fraction >= 0.5) - (fraction <= -0.5);
+  const uint32_t p0 = uint32_t(Logistic::squash(rounded)) << 3;
   return uint16_t(std::clamp<uint32_t>(p0, 64, kProbabilityOne - 64));
 }
 
