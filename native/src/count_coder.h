@@ -9,12 +9,10 @@
 //   - the node of the bisection tree (the decisions taken so far),
 //   - and, in a complex, a class of the cell's neighbourhood
 //     (PositionPredictor::countContext) and where the neighbours'
-//     parallelogram predictions put the cell's vertex (bunny −0.02 bits per
-//     vertex, triceratops −0.07), whose models are mixed with the one above.
-//     Populations above 15 share one neighbourhood model per class and tree
-//     node: few cells are that large (bunny −0.06 bits per vertex; −0.05
-//     with a row per bit width of the population, which learns more
-//     slowly),
+//     parallelogram predictions put the cell's vertex, whose models are
+//     mixed with the one above. Populations above 15 share one
+//     neighbourhood model per class and tree node: few cells are that large,
+//     and a row per bit width of the population learns more slowly,
 //   - and by where the neighbours lie along the split axis, and which of
 //     them have split at this level already (PositionPredictor::
 //     refinementClass), a fourth model mixed in.
@@ -132,8 +130,8 @@ class CountCoder {
             : nullptr;
     // And with the model of where the neighbours lie along the split axis,
     // by tree node (the root, the two of the second decision, then one;
-    // by population group as well: 14.7 KB more priors for ±0.016 bits per
-    // vertex).
+    // not by population group as well, whose priors cost more than they
+    // gain: docs/EXPERIMENTS.md).
     BitModel* byRefinement =
         neighbourhoodClass > 0 ? &refinementModels_[size_t(context.refinement) * kRefinementNodes] : nullptr;
     uint32_t low = 0, candidates = population + 1, node = 1;

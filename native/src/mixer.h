@@ -71,8 +71,7 @@ class Mixer {
 
   const std::vector<std::array<int32_t, kInputs>>& weights() const { return weights_; }
   // How many bits each weight vector has mixed (what training averages the
-  // learned starting weights by; the count costs no measurable decoding
-  // time: bunny 1.551 G instructions with it, 1.555 G without).
+  // learned starting weights by).
   const std::vector<uint32_t>& uses() const { return uses_; }
 
   // The mix of `inputs` in the logistic domain, clamped to [-2047, 2047].
@@ -112,7 +111,7 @@ class Mixer {
 
   void update(bool bit) {
     // A small rate: the inputs are adaptive models already, the weights
-    // only settle how far to trust each (rates 2^-9 and faster measured worse).
+    // only settle how far to trust each.
     const int error = (bit ? 0 : 4095) - mixed_;
     for (int i = 0; i < kInputs; ++i)
       weights_[size_t(set_)][size_t(i)] += (stretched_[size_t(i)] * error) >> 10;
@@ -139,13 +138,10 @@ class Mixer {
 // Codes `bit` (encoder; the decoder returns the decoded bit) with the mean,
 // in the logistic domain, of several mixers of the same inputs, each mixing
 // with the weight vector `sets[i]` chosen by a context of its own: each
-// learns how far to trust the inputs in its context (one-vertex splits
-// with three mixers, their starting weights learned, against the first
-// alone: bunny −0.071 bits per vertex, triceratops −0.077, fandisk −0.147,
-// dragon −0.038). Then the inputs and every mixer update, each mixer from
-// its own logit's error.
+// learns how far to trust the inputs in its context. Then the inputs and
+// every mixer update, each mixer from its own logit's error.
 // Inlined always: out of line, the range coder's state went through memory
-// at every bit (bunny decode +0.8 % instructions).
+// at every bit.
 template <class Coder, int kInputs, size_t kMixers>
 [[gnu::always_inline]] inline bool codeWithMixers(Coder& coder, const std::array<Mixer<kInputs>*, kMixers>& mixers,
                                                   const std::array<int, kMixers>& sets,

@@ -49,9 +49,9 @@ constexpr uint8_t kPriorRunMarker = 0;
 // Priors are stored one byte each, as their logit: code q stands for
 // P(0) = squash((q − 128) · 16) · 8 in units of 2^-15 (mixer.h's logistic
 // functions, exact integers), q in 1..255; 128 is exactly 1/2. Half the
-// size of 15-bit probabilities in the WebAssembly module (17.6 KB less),
-// and fine where a prior's precision matters, near 0 and 1: a step is
-// 0.006 % at 99.9 %, where a byte of plain probability would step 0.4 %.
+// size of 15-bit probabilities in the WebAssembly module, and fine where a
+// prior's precision matters, near 0 and 1, where a byte of plain
+// probability would step coarsely.
 constexpr uint8_t kHalfPriorCode = 128;
 uint8_t priorCode(uint32_t probabilityOfZero);
 uint16_t priorOfCode(uint8_t code);
@@ -83,8 +83,8 @@ constexpr uint16_t kPriorObservations = 24;
 // The mixers whose starting weights are learned the same way (the final
 // weights of each weight vector, averaged over the training meshes by how
 // often the vector was used): a small model's mixer codes many of its bits
-// before its weights have moved far from any fixed start (triceratops −0.06
-// bits per vertex, fandisk −0.02). One-vertex splits average three mixers
+// before its weights have moved far from any fixed start. One-vertex
+// splits average three mixers
 // (codeWithMixers in mixer.h), with weight vectors chosen by the
 // neighbourhood's scale, elongation and agreement, by the parallelogram
 // bucket, and by the centroid and plane buckets; edge codes mix four rows

@@ -53,8 +53,7 @@ int tiltClass(double tilt) {
 // all three: 3 · (squared offsets along the axis) / (squared offsets), < 0.5,
 // < 1.6 or more. Neighbours strung out along the axis leave a vertex's
 // position along it (or a cell's split) less certain than the other
-// features say: the mixers weigh their models by it (bunny −0.08 bits per
-// vertex, fandisk −0.09, dragon −0.04).
+// features say: the mixers weigh their models by it.
 int elongationGroup(double squared, double along) {
   static constexpr double kBounds[kElongationGroups - 1] = {0.5, 1.6};
   return squared > 0 ? countAtMost(3 * along / squared, kBounds) : 1;
@@ -169,9 +168,8 @@ namespace {
 // a logistic of t / sqrt(s² + q): q stands for the error of the
 // neighbours' own cells, which the deviation does not see when the
 // predictions agree. The models bucket t and s; this input, unbucketed,
-// lets the mixers weigh how far apart within a bucket they are (bunny
-// −0.041 bits per vertex, triceratops −0.059, fandisk −0.071; scale and q
-// tuned on these three: within 0.02 for scales 300–1000 and q 0.15–0.5).
+// lets the mixers weigh how far apart within a bucket they are (scale and
+// q tuned on the bunny, triceratops and fandisk: docs/EXPERIMENTS.md).
 uint16_t parallelogramOdds(const double offset, const double spread) {
   constexpr double kVariance = 0.15, kScale = 700;  // squared half widths; logistic units of 1/256
   const double logit = std::clamp(kScale * offset / std::sqrt(spread + kVariance), -2047.0, 2047.0);
@@ -300,9 +298,9 @@ void PositionPredictor::forgetAcross(uint32_t triangle, uint32_t position) {
     if (p != position) acrossSlots_[first + p] = kUnknown;
 }
 
-// The incidence lists are walked where they are. A snapshot of them in
-// contiguous rows, rebuilt twice per level, took more instructions (bunny
-// decode 1.156 G against 1.135 G) and 24 bytes per triangle more memory.
+// The incidence lists are walked where they are: a copy of them in
+// contiguous rows, rebuilt twice per level, took more instructions and
+// memory (docs/EXPERIMENTS.md).
 bool PositionPredictor::gather(uint32_t vertex, int level, Neighbourhood& around) {
   if (vertex >= store_.vertexCapacity() || vertex >= places_.size()) return false;
   const int axis = axis_[size_t(level)];

@@ -30,12 +30,9 @@
 //     the triangle b a c across its far edge predict v at a + b − c (the
 //     rule single-rate coders predict with, here from the current
 //     complex); their median, and their median absolute deviation, which
-//     says how far to trust it (with their model for cell counts,
-//     count_coder.h, and as mean and variance: bunny −0.50 bits per vertex,
-//     fandisk −0.69, triceratops −0.46, dragon −0.05, tetrahedral ball
-//     −0.24; the median and its deviation, robust against the
-//     parallelograms that span a crease or a fold, took another −0.26,
-//     −0.26 and −0.25 on the first three).
+//     says how far to trust it (also for cell counts, count_coder.h); the
+//     median and its deviation rather than the mean and variance, since
+//     they hold against the parallelograms that span a crease or a fold.
 // And one more, from the order of coding: cells split level by level, so
 // the neighbours coded before the vertex at this level are known to half
 // a cell more. A neighbour in the cell's own slab along the split axis
@@ -44,8 +41,7 @@
 // axis (on the fandisk's faces, which are flat, nearly always). The
 // refinement class counts those neighbours by half and the slab's
 // neighbours not split yet, and says which halves of the two slabs beside
-// the cell hold a neighbour (bunny −0.87 bits per vertex, fandisk −0.81,
-// triceratops −0.37, dragon −1.27, with its cell-count model).
+// the cell hold a neighbour (also for cell counts).
 //
 // The configuration is mirrored so that the prediction points to the upper
 // half, which lets the two mirror images share statistics. A one-vertex split

@@ -135,9 +135,7 @@ class SimplexStore {
   // before they load a simplex's vertices. Entries are never erased: one
   // whose simplex was killed or has changed vertices since is skipped by
   // find(), and the table is rebuilt from the live simplices when it fills
-  // (perf on the dragon's encoding: finding, hashing and erasing entries
-  // had taken about 30 % of the samples, erasing 7 %; the encoding went
-  // from 10.4–11.9 s to 9.2–9.4 s).
+  // (erasing entries had cost more than skipping them).
   struct IndexSlot {
     uint32_t simplex = kNoSimplex;
     uint32_t hash = 0;

@@ -155,8 +155,7 @@ static int directionBucket(double cosine) {
 // other side, and which of the two is closer to the plane. Those two are
 // also the apexes of the triangles on the new edge v v2, which lie close
 // to it: a neighbour farther from v than the star's mean is less likely cut
-// (the paper's Delaunay criterion, coarsely; bunny −0.08 bits per vertex,
-// dragon −0.14).
+// (the paper's Delaunay criterion, coarsely).
 // Class 0: no geometry (splits of coincident vertices).
 void VertexSplitter::classifyEdges(uint32_t v, int level) {
   const size_t first = begin_[1], last = begin_[2];
@@ -175,8 +174,7 @@ void VertexSplitter::classifyEdges(uint32_t v, int level) {
   // In a tetrahedral mesh an edge has many fan neighbours and no crossing
   // to speak of; what tells a cut edge there is its length against the
   // cell: a neighbour within a cell width or so of v lies near the split
-  // plane's patch between v and v2 (tetrahedral ball: −0.7 bits per vertex
-  // against the crossing class).
+  // plane's patch between v and v2, which the crossing class does not see.
   const bool volume = begin_[4] > begin_[3];
   double meanLength = 0;
   for (size_t i = first; i < last; ++i) {
@@ -255,8 +253,7 @@ int VertexSplitter::pairingSlack(const Entry& triangle) const {
 }
 
 // Brings the most constrained of the triangles still to be coded to
-// codingOrder_[step]: each code-4 decision there tightens the others
-// (tetrahedral ball: triangle codes −8 % against the canonical order).
+// codingOrder_[step]: each code-4 decision there tightens the others.
 // split() stops calling it once the paired triangles are coded (the rest
 // keep their order), so a split costs O(paired × triangles) here.
 void VertexSplitter::takeMostConstrainedTriangle(size_t step) {
@@ -389,10 +386,9 @@ int cappedValence(const SimplexStore& store, uint32_t vertex) {
 // the fan (c: a cut edge, coded 4), so the codes already given around the
 // fan say much about an uncoded edge: the run of uncoded edges that holds
 // it lies between two coded ends, and a run between a 1 and a 2 holds a
-// cut (bunny −0.086 bits per vertex, triceratops −0.107, fandisk −0.049
-// against the immediate fan neighbours' codes alone). Once a cut is known,
-// the other lies about half way around (×kCutBands: how far this edge is
-// from it). A star that is not one closed fan is classed by the immediate
+// cut, which the immediate fan neighbours' codes alone do not say. Once a
+// cut is known, the other lies about half way around (×kCutBands: how far
+// this edge is from it). A star that is not one closed fan is classed by the immediate
 // fan neighbours' codes, by whether the edge is in three or more
 // triangles, and by whether v and v2 are joined.
 int VertexSplitter::runClass(const Entry& edge, int cutEdges, bool mirrored) {
@@ -435,8 +431,7 @@ int VertexSplitter::runClass(const Entry& edge, int cutEdges, bool mirrored) {
     // diagonal from e to the far half or from o to the near one; the
     // shorter is the likelier (the Delaunay criterion). A cut neighbour
     // gains an edge, and meshes keep valences even: the one with fewer
-    // edges is the likelier cut (bunny −0.030 bits per vertex, fandisk
-    // −0.058).
+    // edges is the likelier cut.
     const bool besideOne = (before == 1 ? a : b) == 0;
     const uint32_t other = fanOrder_[size_t((edge.fanIndex + (before == 1 ? 1 : -1) + fanSize_) % fanSize_)];
     const size_t e = size_t(&edge - star_.data()) - begin_[1], o = size_t(other) - begin_[1];
@@ -460,8 +455,7 @@ int VertexSplitter::runClass(const Entry& edge, int cutEdges, bool mirrored) {
 // triangles is that of two vertices that met in a cell without an edge
 // between them, the more often the more such edges (classes by the extra
 // fan neighbours, 0..4 and more); and whether the cell held two vertices
-// (against one model: triceratops −0.200 bits per vertex, fandisk −0.088,
-// bunny −0.034).
+// (rather than one model for all).
 int VertexSplitter::vertexClass(int balance) const {
   const int shape = fanSize_ > 0 ? 0 : 1 + std::min(crowdedLinks_, 4);
   return shape * 2 + (balance == 1);

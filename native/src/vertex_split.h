@@ -12,8 +12,7 @@
 // the one pointing most steeply across the split plane to the one lying
 // most in it: an edge far from the plane goes to its side's vertex almost
 // surely, and the codes it gets then tell its fan neighbours near the plane,
-// the likely cut edges, where the fan crosses (−15 % of the edge bits on the
-// bunny against the canonical order). Closure limits
+// the likely cut edges, where the fan crosses. Closure limits
 // each code by those of the simplex's faces through V (a face coded 1 forces
 // 1, a face coded 2 forces 2, a face coded 3 excludes 4, and the code of S
 // must allow its children's faces), so implied codes cost nothing; the rest
@@ -223,8 +222,7 @@ class VertexSplitter {
   // cut state is the count of edges coded 4 so far (0..2) or, at geometric
   // levels, 3 + that count (0 or 1) when no more edges are left to code
   // than an edge expansion still needs cut ones: coded last, being closest
-  // to the split plane, those usually are (bunny −0.047 bits per vertex,
-  // dragon −0.083).
+  // to the split plane, those usually are.
   static constexpr int kCutStates = 5;
   BitModel edgeModels_[kCutStates][8][kEdgeClasses][2][3];
   // Edges by direction class alone, mixed with the above (weight vectors
@@ -232,11 +230,9 @@ class VertexSplitter {
   // closed fan).
   BitModel edgeDirectionModels_[kEdgeClasses][2][3];
   // Edges of surface stars by splitBalance() and direction class, mixed in
-  // third (with learned priors: dragon −0.114 bits per vertex, bunny
-  // −0.051, fandisk −0.065, triceratops −0.070); a tetrahedral star mixes a
-  // model reset to 1/2 at every edge instead, whose stretch of 0 leaves its
-  // mix and weights as a two-input mix would (the ball lost 0.014 by the
-  // balance).
+  // third (with learned priors); a tetrahedral star, which the balance does
+  // not help, mixes a model reset to 1/2 at every edge instead, whose
+  // stretch of 0 leaves its mix and weights as a two-input mix would.
   static constexpr int kBalanceClasses = 9;
   BitModel edgeBalanceModels_[kBalanceClasses][kEdgeClasses][2][3];
   BitModel neutral_[3];
@@ -319,8 +315,8 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int
       const bool lastCuts = geometric && cut < 2 && edgesLeft <= size_t(2 - cut);
       const int cutState = lastCuts ? 3 + cut : cut;
       // In a tetrahedral star an edge to v2's half is coded mirrored: the
-      // two sides share statistics (tetrahedral ball: −0.08 bits per
-      // vertex; surfaces lose by it, their split is not symmetric enough).
+      // two sides share statistics (surfaces lose by it, their split is not
+      // symmetric enough).
       const bool mirrored = volume && geometric && cosines_[index - begin_[1]] > 0;
       if (volume) std::fill(neutral_, neutral_ + 3, BitModel{});
       // Weight vectors by cut state (the last two share one) and whether
