@@ -68,22 +68,29 @@ class CountCoder {
     static_assert(size_t(kNeighbourhoodClasses) * kNeighbourhoodNodes == kFamilySize[int(ModelFamily::CellCounts)]);
     if (neighbourhoods) {
       neighbourhoodModels_.resize(kFamilySize[int(ModelFamily::CellCounts)]);
-      primeModels(ModelFamily::CellCounts, neighbourhoodModels_.data());
       static_assert(size_t(kPopulationGroups) * CountContext::kParallelogramBuckets * kParallelogramNodes ==
                     kFamilySize[int(ModelFamily::CellCountsByParallelogram)]);
       parallelogramModels_.resize(kFamilySize[int(ModelFamily::CellCountsByParallelogram)]);
-      primeModels(ModelFamily::CellCountsByParallelogram, parallelogramModels_.data());
       static_assert(size_t(CountContext::kRefinementClasses) * kRefinementNodes ==
                     kFamilySize[int(ModelFamily::CellCountsByRefinement)]);
       refinementModels_.resize(kFamilySize[int(ModelFamily::CellCountsByRefinement)]);
-      primeModels(ModelFamily::CellCountsByRefinement, refinementModels_.data());
+      forEachFamily(primeModels);
     }
   }
 
-  const std::vector<BitModel>& neighbourhoodModels() const { return neighbourhoodModels_; }
-  const std::vector<BitModel>& parallelogramModels() const { return parallelogramModels_; }
-  const std::vector<BitModel>& refinementModels() const { return refinementModels_; }
-  const Mixer<4>& mixer() const { return mixer_; }
+  // Its model families with learned priors (none without neighbourhoods)
+  // and its mixer, as PositionPredictor::forEachFamily() lists its own.
+  template <class Visit>
+  void forEachFamily(Visit&& visit) {
+    if (neighbourhoodModels_.empty()) return;
+    visit(ModelFamily::CellCounts, neighbourhoodModels_.data());
+    visit(ModelFamily::CellCountsByParallelogram, parallelogramModels_.data());
+    visit(ModelFamily::CellCountsByRefinement, refinementModels_.data());
+  }
+  template <class Visit>
+  void forEachMixer(Visit&& visitMixer) const {
+    visitMixer(MixerFamily::CellCounts, mixer_);
+  }
 
   // The count of a one-vertex cell, 1 when the vertex is in the first half;
   // the same model as code() with population 1, in a loop-free form.

@@ -197,6 +197,27 @@ struct RecordReader {
   uint8_t operator()() { return *next++; }
 };
 
+// The final states of the models and mixers, for learning their priors
+// (tools/train_priors.cpp).
+void exportModels(PositionPredictor& predictor, CountCoder& counts, VertexSplitter& splitter,
+                  TrainedModels& out) {
+  auto keep = [&out](ModelFamily family, const BitModel* models) {
+    out.families[size_t(family)].assign(models, models + kFamilySize[size_t(family)]);
+  };
+  auto keepMixer = [&out](MixerFamily family, const auto& mixer) {
+    std::vector<int32_t>& weights = out.mixerWeights[size_t(family)];
+    weights.clear();
+    for (const auto& set : mixer.weights()) weights.insert(weights.end(), set.begin(), set.end());
+    out.mixerUses[size_t(family)] = mixer.uses();
+  };
+  predictor.forEachFamily(keep);
+  counts.forEachFamily(keep);
+  splitter.forEachFamily(keep);
+  predictor.forEachMixer(keepMixer);
+  counts.forEachMixer(keepMixer);
+  splitter.forEachMixer(keepMixer);
+}
+
 }  // namespace
 
 EncodeResult encode(const Complex& complex, const EncodeOptions& options) {
@@ -326,36 +347,7 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
   result.cost.connectivityBits = connectivityBits;
   result.cost.geometryBits = coder.cost() - connectivityBits;
   result.statistics = splitter.statistics();
-  if (finalModels && connectivity) {
-    auto keep = [&](ModelFamily family, const BitModel* models) {
-      finalModels->families[int(family)].assign(models, models + kFamilySize[int(family)]);
-    };
-    keep(ModelFamily::OneVertexSplits, predictor.models().data());
-    keep(ModelFamily::OneVertexByPlane, predictor.planeModels().data());
-    keep(ModelFamily::OneVertexByCentroid, predictor.centroidModels().data());
-    keep(ModelFamily::OneVertexByParallelogram, predictor.parallelogramModels().data());
-    keep(ModelFamily::OneVertexByRefinement, predictor.refinementModels().data());
-    keep(ModelFamily::CellCounts, counts.neighbourhoodModels().data());
-    keep(ModelFamily::CellCountsByParallelogram, counts.parallelogramModels().data());
-    keep(ModelFamily::CellCountsByRefinement, counts.refinementModels().data());
-    keep(ModelFamily::EdgeCodes, splitter.edgeModels());
-    keep(ModelFamily::EdgeCodesByDirection, splitter.edgeDirectionModels());
-    keep(ModelFamily::EdgeCodesByBalance, splitter.edgeBalanceModels());
-    keep(ModelFamily::TriangleCodes, splitter.triangleModels());
-    keep(ModelFamily::EdgeCodesByRun, splitter.edgeRunModels());
-    keep(ModelFamily::VertexCodes, splitter.vertexModels());
-    auto keepMixer = [&](MixerFamily family, const auto& mixer) {
-      std::vector<int32_t>& weights = finalModels->mixerWeights[int(family)];
-      weights.clear();
-      for (const auto& set : mixer.weights()) weights.insert(weights.end(), set.begin(), set.end());
-      finalModels->mixerUses[int(family)] = mixer.uses();
-    };
-    keepMixer(MixerFamily::OneVertexSplits, predictor.mixer(MixerFamily::OneVertexSplits));
-    keepMixer(MixerFamily::OneVertexByParallelogram, predictor.mixer(MixerFamily::OneVertexByParallelogram));
-    keepMixer(MixerFamily::OneVertexByPlaneAndCentroid, predictor.mixer(MixerFamily::OneVertexByPlaneAndCentroid));
-    keepMixer(MixerFamily::CellCounts, counts.mixer());
-    keepMixer(MixerFamily::EdgeCodes, splitter.edgeMixer());
-  }
+  if (finalModels && connectivity) exportModels(predictor, counts, splitter, *finalModels);
 
   predictor.addStatistics(result.statistics);
   report("code", 1);

@@ -10,24 +10,13 @@
 namespace kdmesh {
 namespace {
 
-// kOneVertexSplitPriors, kEdgeCodePriors, kCellCountPriors,
-// kOneVertexByPlanePriors, kOneVertexByCentroidPriors,
-// kEdgeCodeByDirectionPriors, kTriangleCodePriors,
-// kOneVertexByParallelogramPriors, kCellCountByParallelogramPriors,
-// kEdgeCodeByBalancePriors, kEdgeCodeByRunPriors, kVertexCodePriors,
-// kOneVertexByRefinementPriors, kCellCountByRefinementPriors: P(bit == 0) as
-// priorCode(), one byte per model, run-length coded (model_priors.h);
-// kOneVertexMixerPriors, kCellCountMixerPriors,
-// kOneVertexByParallelogramMixerPriors,
-// kOneVertexByPlaneAndCentroidMixerPriors, kEdgeCodeMixerPriors: starting
-// mixer weights.
+// The arrays KDMESH_MODEL_FAMILIES names: P(bit == 0) as priorCode(), one
+// byte per model, run-length coded (model_priors.h); and those
+// KDMESH_MIXER_FAMILIES names: starting mixer weights.
 #include "model_priors.inc"
 
-static_assert(std::size(kOneVertexMixerPriors) == kMixerSets[0] * kMixerInputs[0]);
-static_assert(std::size(kCellCountMixerPriors) == kMixerSets[1] * kMixerInputs[1]);
-static_assert(std::size(kOneVertexByParallelogramMixerPriors) == kMixerSets[2] * kMixerInputs[2]);
-static_assert(std::size(kOneVertexByPlaneAndCentroidMixerPriors) == kMixerSets[3] * kMixerInputs[3]);
-static_assert(std::size(kEdgeCodeMixerPriors) == kMixerSets[4] * kMixerInputs[4]);
+#define KDMESH_CHECK_MIXER_SIZE(name, priors, sets, inputs) static_assert(std::size(priors) == (sets) * (inputs));
+KDMESH_MIXER_FAMILIES(KDMESH_CHECK_MIXER_SIZE)
 
 // How many models a run-length coded family primes.
 template <size_t kCoded>
@@ -37,20 +26,8 @@ constexpr size_t expandedSize(const uint8_t (&coded)[kCoded]) {
   return models;
 }
 
-static_assert(expandedSize(kOneVertexSplitPriors) == kFamilySize[0]);
-static_assert(expandedSize(kEdgeCodePriors) == kFamilySize[1]);
-static_assert(expandedSize(kCellCountPriors) == kFamilySize[2]);
-static_assert(expandedSize(kOneVertexByPlanePriors) == kFamilySize[3]);
-static_assert(expandedSize(kOneVertexByCentroidPriors) == kFamilySize[4]);
-static_assert(expandedSize(kEdgeCodeByDirectionPriors) == kFamilySize[5]);
-static_assert(expandedSize(kTriangleCodePriors) == kFamilySize[6]);
-static_assert(expandedSize(kOneVertexByParallelogramPriors) == kFamilySize[7]);
-static_assert(expandedSize(kCellCountByParallelogramPriors) == kFamilySize[8]);
-static_assert(expandedSize(kEdgeCodeByBalancePriors) == kFamilySize[9]);
-static_assert(expandedSize(kEdgeCodeByRunPriors) == kFamilySize[10]);
-static_assert(expandedSize(kVertexCodePriors) == kFamilySize[11]);
-static_assert(expandedSize(kOneVertexByRefinementPriors) == kFamilySize[12]);
-static_assert(expandedSize(kCellCountByRefinementPriors) == kFamilySize[13]);
+#define KDMESH_CHECK_FAMILY_SIZE(name, priors, size) static_assert(expandedSize(priors) == (size));
+KDMESH_MODEL_FAMILIES(KDMESH_CHECK_FAMILY_SIZE)
 
 struct CodedFamily {
   const uint8_t* values;
@@ -84,22 +61,14 @@ uint16_t priorOfCode(uint8_t code) {
 }
 
 const int32_t* mixerPriors(MixerFamily family) {
-  static constexpr const int32_t* kPriors[kMixerFamilies] = {kOneVertexMixerPriors, kCellCountMixerPriors,
-                                                             kOneVertexByParallelogramMixerPriors,
-                                                             kOneVertexByPlaneAndCentroidMixerPriors,
-                                                             kEdgeCodeMixerPriors};
+#define KDMESH_MIXER_PRIORS(name, priors, ...) priors,
+  static constexpr const int32_t* kPriors[kMixerFamilies] = {KDMESH_MIXER_FAMILIES(KDMESH_MIXER_PRIORS)};
   return kPriors[int(family)];
 }
 
 void primeModels(ModelFamily family, BitModel* models) {
-  static constexpr CodedFamily kPriors[kModelFamilies] = {
-      codedFamily(kOneVertexSplitPriors),      codedFamily(kEdgeCodePriors),
-      codedFamily(kCellCountPriors),           codedFamily(kOneVertexByPlanePriors),
-      codedFamily(kOneVertexByCentroidPriors), codedFamily(kEdgeCodeByDirectionPriors),
-      codedFamily(kTriangleCodePriors),        codedFamily(kOneVertexByParallelogramPriors),
-      codedFamily(kCellCountByParallelogramPriors), codedFamily(kEdgeCodeByBalancePriors),
-      codedFamily(kEdgeCodeByRunPriors), codedFamily(kVertexCodePriors),
-      codedFamily(kOneVertexByRefinementPriors), codedFamily(kCellCountByRefinementPriors)};
+#define KDMESH_CODED_FAMILY(name, priors, ...) codedFamily(priors),
+  static constexpr CodedFamily kPriors[kModelFamilies] = {KDMESH_MODEL_FAMILIES(KDMESH_CODED_FAMILY)};
   const CodedFamily& coded = kPriors[int(family)];
   forEachPriorCode(coded.values, coded.size, [&models](uint8_t code) {
     models->fast = models->slow = priorOfCode(code);

@@ -20,25 +20,31 @@
 
 namespace kdmesh {
 
-enum class ModelFamily {
-  OneVertexSplits,
-  EdgeCodes,
-  CellCounts,
-  OneVertexByPlane,
-  OneVertexByCentroid,
-  EdgeCodesByDirection,
-  TriangleCodes,
-  OneVertexByParallelogram,
-  CellCountsByParallelogram,
-  EdgeCodesByBalance,
-  EdgeCodesByRun,
-  VertexCodes,
-  OneVertexByRefinement,
-  CellCountsByRefinement,
-};
-constexpr int kModelFamilies = 14;
-constexpr std::array<size_t, kModelFamilies> kFamilySize = {9000, 11760, 3042, 300, 250, 294, 864,
-                                                            648,  768,   2646, 1980, 36, 8192, 4096};
+// Every family of models with learned priors, declared once: its name, the
+// array of model_priors.inc that holds its priors, and how many models it
+// has. The enumeration, the sizes, the priming and the trainer read this
+// list; the classes that own the models list theirs with forEachFamily().
+#define KDMESH_MODEL_FAMILIES(X)                                   \
+  X(OneVertexSplits, kOneVertexSplitPriors, 9000)                  \
+  X(EdgeCodes, kEdgeCodePriors, 11760)                             \
+  X(CellCounts, kCellCountPriors, 3042)                            \
+  X(OneVertexByPlane, kOneVertexByPlanePriors, 300)                \
+  X(OneVertexByCentroid, kOneVertexByCentroidPriors, 250)          \
+  X(EdgeCodesByDirection, kEdgeCodeByDirectionPriors, 294)         \
+  X(TriangleCodes, kTriangleCodePriors, 864)                       \
+  X(OneVertexByParallelogram, kOneVertexByParallelogramPriors, 648) \
+  X(CellCountsByParallelogram, kCellCountByParallelogramPriors, 768) \
+  X(EdgeCodesByBalance, kEdgeCodeByBalancePriors, 2646)            \
+  X(EdgeCodesByRun, kEdgeCodeByRunPriors, 1980)                    \
+  X(VertexCodes, kVertexCodePriors, 36)                            \
+  X(OneVertexByRefinement, kOneVertexByRefinementPriors, 8192)     \
+  X(CellCountsByRefinement, kCellCountByRefinementPriors, 4096)
+
+#define KDMESH_FAMILY_NAME(name, priors, ...) name,
+#define KDMESH_FAMILY_SIZE(name, priors, size) size_t{size},
+enum class ModelFamily { KDMESH_MODEL_FAMILIES(KDMESH_FAMILY_NAME) };
+constexpr std::array kFamilySize = {KDMESH_MODEL_FAMILIES(KDMESH_FAMILY_SIZE)};
+constexpr int kModelFamilies = int(kFamilySize.size());
 
 // model_priors.inc holds each family run-length coded: half the models of
 // the large families were never used in training and start at 1/2; a run of
@@ -89,10 +95,21 @@ constexpr uint16_t kPriorObservations = 24;
 // neighbourhood's scale, elongation and agreement, by the parallelogram
 // bucket, and by the centroid and plane buckets; edge codes mix four rows
 // of models (VertexSplitter::split).
-enum class MixerFamily { OneVertexSplits, CellCounts, OneVertexByParallelogram, OneVertexByPlaneAndCentroid, EdgeCodes };
-constexpr int kMixerFamilies = 5;
-constexpr std::array<size_t, kMixerFamilies> kMixerSets = {45, 39, 12, 60, 8};
-constexpr std::array<size_t, kMixerFamilies> kMixerInputs = {6, 4, 6, 6, 4};
+// Declared once as the model families are: name, array of starting
+// weights in model_priors.inc, weight vectors, inputs.
+#define KDMESH_MIXER_FAMILIES(X)                                           \
+  X(OneVertexSplits, kOneVertexMixerPriors, 45, 6)                         \
+  X(CellCounts, kCellCountMixerPriors, 39, 4)                              \
+  X(OneVertexByParallelogram, kOneVertexByParallelogramMixerPriors, 12, 6) \
+  X(OneVertexByPlaneAndCentroid, kOneVertexByPlaneAndCentroidMixerPriors, 60, 6) \
+  X(EdgeCodes, kEdgeCodeMixerPriors, 8, 4)
+
+#define KDMESH_MIXER_SETS(name, priors, sets, inputs) size_t{sets},
+#define KDMESH_MIXER_INPUTS(name, priors, sets, inputs) size_t{inputs},
+enum class MixerFamily { KDMESH_MIXER_FAMILIES(KDMESH_FAMILY_NAME) };
+constexpr std::array kMixerSets = {KDMESH_MIXER_FAMILIES(KDMESH_MIXER_SETS)};
+constexpr std::array kMixerInputs = {KDMESH_MIXER_FAMILIES(KDMESH_MIXER_INPUTS)};
+constexpr int kMixerFamilies = int(kMixerSets.size());
 // The starting weights of a mixer family: kMixerSets × kMixerInputs values,
 // weight vector by weight vector, in units of 2^-16.
 const int32_t* mixerPriors(MixerFamily family);

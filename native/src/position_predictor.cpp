@@ -218,12 +218,8 @@ PositionPredictor::PositionPredictor(const SplitSchedule& schedule, const Simple
                 kMixerInputs[int(MixerFamily::OneVertexByParallelogram)] == kSingleInputs);
   static_assert(kCentroidBuckets * kPlaneBuckets == kMixerSets[int(MixerFamily::OneVertexByPlaneAndCentroid)] &&
                 kMixerInputs[int(MixerFamily::OneVertexByPlaneAndCentroid)] == kSingleInputs);
-  primeModels(ModelFamily::OneVertexSplits, models_.data());
-  primeModels(ModelFamily::OneVertexByPlane, planeModels_.data());
-  primeModels(ModelFamily::OneVertexByCentroid, centroidModels_.data());
-  primeModels(ModelFamily::OneVertexByParallelogram, parallelogramModels_.data());
   static_assert(kRefinementModels == kFamilySize[int(ModelFamily::OneVertexByRefinement)]);
-  primeModels(ModelFamily::OneVertexByRefinement, refinementModels_.data());
+  forEachFamily(primeModels);
   widths_.resize(size_t(schedule.levels) + 1);
   for (size_t level = 0; level < widths_.size(); ++level)
     for (int a = 0; a < 3; ++a)

@@ -170,16 +170,22 @@ class PositionPredictor {
     for (int a = 0; a < 3; ++a) out[a] = places_[vertex].centre[a];
   }
 
-  const std::vector<BitModel>& models() const { return models_; }
-  const std::vector<BitModel>& planeModels() const { return planeModels_; }
-  const std::vector<BitModel>& centroidModels() const { return centroidModels_; }
-  const std::vector<BitModel>& parallelogramModels() const { return parallelogramModels_; }
-  const std::vector<BitModel>& refinementModels() const { return refinementModels_; }
-  // One of the three mixers of one-vertex splits.
-  const Mixer<kSingleInputs>& mixer(MixerFamily family) const {
-    return family == MixerFamily::OneVertexByParallelogram      ? parallelogramMixer_
-           : family == MixerFamily::OneVertexByPlaneAndCentroid ? planeAndCentroidMixer_
-                                                                : mixer_;
+  // Its model families, visit(family, first model), and its mixers,
+  // visitMixer(family, mixer): what the constructor primes and training
+  // reads (tools/train_priors.cpp).
+  template <class Visit>
+  void forEachFamily(Visit&& visit) {
+    visit(ModelFamily::OneVertexSplits, models_.data());
+    visit(ModelFamily::OneVertexByPlane, planeModels_.data());
+    visit(ModelFamily::OneVertexByCentroid, centroidModels_.data());
+    visit(ModelFamily::OneVertexByParallelogram, parallelogramModels_.data());
+    visit(ModelFamily::OneVertexByRefinement, refinementModels_.data());
+  }
+  template <class Visit>
+  void forEachMixer(Visit&& visitMixer) const {
+    visitMixer(MixerFamily::OneVertexSplits, mixer_);
+    visitMixer(MixerFamily::OneVertexByParallelogram, parallelogramMixer_);
+    visitMixer(MixerFamily::OneVertexByPlaneAndCentroid, planeAndCentroidMixer_);
   }
 
   // Adds the prediction counters to `statistics`.

@@ -105,19 +105,33 @@ class VertexSplitter {
   VertexSplitter(SimplexStore& store, PositionPredictor& geometry)
       : store_(store), geometry_(geometry) {
     static_assert(sizeof(edgeModels_) / sizeof(BitModel) == kFamilySize[int(ModelFamily::EdgeCodes)]);
-    primeModels(ModelFamily::EdgeCodes, edgeModels());
     static_assert(sizeof(edgeDirectionModels_) / sizeof(BitModel) ==
                   kFamilySize[int(ModelFamily::EdgeCodesByDirection)]);
-    primeModels(ModelFamily::EdgeCodesByDirection, edgeDirectionModels());
     static_assert(sizeof(edgeBalanceModels_) / sizeof(BitModel) == kFamilySize[int(ModelFamily::EdgeCodesByBalance)]);
-    primeModels(ModelFamily::EdgeCodesByBalance, edgeBalanceModels());
     static_assert(sizeof(triangleModels_[0]) / sizeof(BitModel) == kFamilySize[int(ModelFamily::TriangleCodes)]);
-    for (auto& models : triangleModels_) primeModels(ModelFamily::TriangleCodes, &models[0][0][0]);
     static_assert(sizeof(edgeRunModels_) / sizeof(BitModel) == kFamilySize[int(ModelFamily::EdgeCodesByRun)]);
-    primeModels(ModelFamily::EdgeCodesByRun, edgeRunModels());
     static_assert(sizeof(vertexModels_) / sizeof(BitModel) == kFamilySize[int(ModelFamily::VertexCodes)]);
-    primeModels(ModelFamily::VertexCodes, vertexModels());
     static_assert(kMixerSets[int(MixerFamily::EdgeCodes)] == 8 && kMixerInputs[int(MixerFamily::EdgeCodes)] == kEdgeInputs);
+    forEachFamily(primeModels);
+    // Every pairing class of triangle codes starts from the same priors.
+    for (auto& models : triangleModels_) std::copy_n(&triangleModels_[0][0][0][0], kFamilySize[int(ModelFamily::TriangleCodes)], &models[0][0][0]);
+  }
+
+  // Its model families with learned priors (of the triangle codes, the
+  // first pairing class's) and its mixer, as PositionPredictor::
+  // forEachFamily() lists its own.
+  template <class Visit>
+  void forEachFamily(Visit&& visit) {
+    visit(ModelFamily::EdgeCodes, &edgeModels_[0][0][0][0][0]);
+    visit(ModelFamily::EdgeCodesByDirection, &edgeDirectionModels_[0][0][0]);
+    visit(ModelFamily::EdgeCodesByBalance, &edgeBalanceModels_[0][0][0][0]);
+    visit(ModelFamily::TriangleCodes, &triangleModels_[0][0][0][0]);
+    visit(ModelFamily::EdgeCodesByRun, &edgeRunModels_[0][0][0]);
+    visit(ModelFamily::VertexCodes, &vertexModels_[0][0]);
+  }
+  template <class Visit>
+  void forEachMixer(Visit&& visitMixer) const {
+    visitMixer(MixerFamily::EdgeCodes, edgeMixer_);
   }
 
   // Splits `v`, whose cell is at `level`, into `v` and `v2`; `balance`:
@@ -129,13 +143,6 @@ class VertexSplitter {
   bool split(Coder& coder, uint32_t v, uint32_t v2, int level, int balance, Oracle&& oracle);
 
   const ConnectivityStatistics& statistics() const { return statistics_; }
-  BitModel* edgeModels() { return &edgeModels_[0][0][0][0][0]; }
-  BitModel* edgeDirectionModels() { return &edgeDirectionModels_[0][0][0]; }
-  BitModel* edgeBalanceModels() { return &edgeBalanceModels_[0][0][0][0]; }
-  BitModel* triangleModels() { return &triangleModels_[0][0][0][0]; }
-  BitModel* edgeRunModels() { return &edgeRunModels_[0][0][0]; }
-  BitModel* vertexModels() { return &vertexModels_[0][0]; }
-  const Mixer<kEdgeInputs>& edgeMixer() const { return edgeMixer_; }
 
  private:
   using Entry = StarEntry;

@@ -34,19 +34,10 @@ constexpr double kMinWeight = 16;
 // model; capped too, so that no mesh dominates.
 constexpr double kMaxMixerUses = 2048;
 constexpr int kFamilies = kdmesh::kModelFamilies + kdmesh::kMixerFamilies;
-constexpr const char* kNames[kFamilies] = {"kOneVertexSplitPriors", "kEdgeCodePriors",
-                                           "kCellCountPriors", "kOneVertexByPlanePriors",
-                                           "kOneVertexByCentroidPriors", "kEdgeCodeByDirectionPriors",
-                                           "kTriangleCodePriors", "kOneVertexByParallelogramPriors",
-                                           "kCellCountByParallelogramPriors", "kEdgeCodeByBalancePriors",
-                                           "kEdgeCodeByRunPriors", "kVertexCodePriors",
-                                           "kOneVertexByRefinementPriors", "kCellCountByRefinementPriors",
-                                           "kOneVertexMixerPriors",
-                                           "kCellCountMixerPriors",
-                                           "kOneVertexByParallelogramMixerPriors",
-                                           "kOneVertexByPlaneAndCentroidMixerPriors",
-                                           "kEdgeCodeMixerPriors"};
-
+// The families' array names in model_priors.inc, model families first.
+const std::string kNames[kFamilies] = {
+#define KDMESH_NAME_OF(name, priors, ...) #priors,
+    KDMESH_MODEL_FAMILIES(KDMESH_NAME_OF) KDMESH_MIXER_FAMILIES(KDMESH_NAME_OF)};
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -55,7 +46,7 @@ int main(int argc, char** argv) {
   if (argc > 2 && std::string(argv[1]) == "--only") {
     only = argv[2];
     for (int f = 0; f < kFamilies; ++f)
-      retrain[size_t(f)] = ("," + only + ",").find("," + std::string(kNames[f]) + ",") != std::string::npos;
+      retrain[size_t(f)] = ("," + only + ",").find("," + kNames[f] + ",") != std::string::npos;
     if (std::count(retrain.begin(), retrain.end(), true) == 0) {
       std::fprintf(stderr, "--only %s: no such family (names as in model_priors.inc)\n", argv[2]);
       return 2;
@@ -133,7 +124,7 @@ int main(int argc, char** argv) {
       codes.push_back(kdmesh::priorCode(uint32_t(prior)));
     }
     const std::vector<uint8_t> coded = kdmesh::runLengthCodePriors(codes);
-    std::fprintf(out, "constexpr uint8_t %s[%zu] = {", kNames[f], coded.size());
+    std::fprintf(out, "constexpr uint8_t %s[%zu] = {", kNames[f].c_str(), coded.size());
     for (size_t i = 0; i < coded.size(); ++i)
       std::fprintf(out, "%s%s%d", i ? "," : "", i % 16 == 0 ? "\n    " : " ", coded[i]);
     std::fprintf(out, "};\n");
@@ -142,7 +133,7 @@ int main(int argc, char** argv) {
     const size_t inputs = kdmesh::kMixerInputs[size_t(f)], values = kdmesh::kMixerSets[size_t(f)] * inputs;
     const int32_t* compiled = kdmesh::mixerPriors(kdmesh::MixerFamily(f));
     const bool learn = retrain[size_t(kdmesh::kModelFamilies + f)];
-    std::fprintf(out, "constexpr int32_t %s[%zu] = {", kNames[kdmesh::kModelFamilies + f], values);
+    std::fprintf(out, "constexpr int32_t %s[%zu] = {", kNames[kdmesh::kModelFamilies + f].c_str(), values);
     for (size_t i = 0; i < values; ++i) {
       const double w = mixerWeight[size_t(f)][i / inputs];
       const long weight = learn && w > 0 ? std::lround(mixerSum[size_t(f)][i] / w) : long(compiled[i]);
