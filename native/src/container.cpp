@@ -94,6 +94,11 @@ Status validate(const Header& h, const DecoderLimits& limits) {
       if (!std::isfinite(h.origin[size_t(a)])) return corrupt("origin is not finite");
     }
     if (!std::isfinite(h.step) || h.step < 0) return corrupt("grid step is not finite");
+    // Every decoded coordinate lies between the origin and its far end,
+    // which must be a finite float32 too.
+    for (int a = 0; a < 3; ++a)
+      if (!std::isfinite(float(double(h.origin[size_t(a)]) + double(h.gridMax[size_t(a)]) * h.step)))
+        return corrupt("the grid's far corner is not a finite float32");
   } else if (h.quantization == Quantization::Float32) {
     if (h.bits != 32) return corrupt("float32 mode must have 32 bits");
     for (int a = 0; a < 3; ++a) {
@@ -128,6 +133,23 @@ Status validate(const Header& h, const DecoderLimits& limits) {
   if (h.bodyBytes < uint64_t(h.chunkCount) * (2 + kChunkChecksumBytes) ||
       (h.chunkCount == 0) != (h.bodyBytes == 0))
     return corrupt("chunk count does not fit the body size");
+  // What a stream decodes to is bounded by its size: a complete decode
+  // needs every byte the header announces.
+  const uint64_t bytes = h.headerBytes + h.bodyBytes;
+  // count <= perByte · bytes, without overflow.
+  auto beyond = [bytes](uint64_t count, uint64_t perByte) {
+    return perByte == 0 ? count > 0 : count / perByte + (count % perByte != 0) > bytes;
+  };
+  if (beyond(h.vertexCount, limits.maxVerticesPerByte))
+    return Status::error(ErrorCode::LimitExceeded,
+                         "a stream of " + std::to_string(bytes) + " bytes with " + std::to_string(h.vertexCount) +
+                             " vertices: more than the decoder limit of " +
+                             std::to_string(limits.maxVerticesPerByte) + " vertices per byte");
+  if (beyond(simplices, limits.maxSimplicesPerByte))
+    return Status::error(ErrorCode::LimitExceeded,
+                         "a stream of " + std::to_string(bytes) + " bytes with " + std::to_string(simplices) +
+                             " simplices: more than the decoder limit of " +
+                             std::to_string(limits.maxSimplicesPerByte) + " simplices per byte");
   if (h.chunkCount == 0 && h.depth() != 0) return corrupt("stream has no chunks");
   return Status::success();
 }
@@ -220,12 +242,20 @@ size_t writeChunkFrame(const ChunkFrame& frame, uint8_t* out) {
   return n + putVarint(out + n, frame.splitCount);
 }
 
-void writeChunkChecksum(const uint8_t* chunk, size_t checked, uint8_t* out) {
-  put32(out, crc32(chunk, checked));
+namespace {
+uint32_t chunkChecksum(const uint8_t* chunk, size_t checked, uint32_t index) {
+  uint8_t position[4];
+  put32(position, index);
+  return crc32(chunk, checked, crc32(position, 4));
+}
+}  // namespace
+
+void writeChunkChecksum(const uint8_t* chunk, size_t checked, uint32_t index, uint8_t* out) {
+  put32(out, chunkChecksum(chunk, checked, index));
 }
 
-bool chunkChecksumMatches(const uint8_t* chunk, size_t checked) {
-  return crc32(chunk, checked) == get32(chunk + checked);
+bool chunkChecksumMatches(const uint8_t* chunk, size_t checked, uint32_t index) {
+  return chunkChecksum(chunk, checked, index) == get32(chunk + checked);
 }
 
 Parsed readChunkFrame(const uint8_t* in, size_t available, ChunkFrame& frame, size_t& size) {

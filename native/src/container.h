@@ -12,7 +12,7 @@
 
 namespace kdmesh {
 
-constexpr uint16_t kFormatVersion = 16;
+constexpr uint16_t kFormatVersion = 17;
 
 // Writes the header (its headerBytes field is ignored) and returns its size.
 size_t writeHeader(const Header& header, uint8_t* out /* kMaxHeaderBytes */);
@@ -40,9 +40,11 @@ constexpr size_t kChunkChecksumBytes = 4;
 
 // Writes the frame and returns its size.
 size_t writeChunkFrame(const ChunkFrame& frame, uint8_t* out /* kMaxChunkFrameBytes */);
-// The checksum after a chunk's first `checked` bytes (frame and payload).
-void writeChunkChecksum(const uint8_t* chunk, size_t checked, uint8_t* out /* kChunkChecksumBytes */);
-bool chunkChecksumMatches(const uint8_t* chunk, size_t checked);
+// The checksum after a chunk's first `checked` bytes (frame and payload):
+// a CRC-32 of the chunk's index in the stream (4 bytes, little-endian) and
+// those bytes, so that a chunk moved, dropped or repeated fails it.
+void writeChunkChecksum(const uint8_t* chunk, size_t checked, uint32_t index, uint8_t* out /* kChunkChecksumBytes */);
+bool chunkChecksumMatches(const uint8_t* chunk, size_t checked, uint32_t index);
 // What a read of bytes that may not all have arrived found.
 enum class Parsed { Complete, Incomplete, Malformed };
 // Reads the frame at the start of in[0..available); `size` gets its size.

@@ -22,10 +22,10 @@ struct Crc32Tables {
 
 }  // namespace
 
-uint32_t crc32(const uint8_t* data, size_t size) {
+uint32_t crc32(const uint8_t* data, size_t size, uint32_t previous) {
   static const Crc32Tables tables;
   const auto& t = tables.t;
-  uint32_t c = 0xffffffffu;
+  uint32_t c = previous ^ 0xffffffffu;
   for (; size >= 4; size -= 4, data += 4) {
     c ^= uint32_t(data[0]) | uint32_t(data[1]) << 8 | uint32_t(data[2]) << 16 |
          uint32_t(data[3]) << 24;

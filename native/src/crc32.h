@@ -7,6 +7,8 @@
 
 namespace kdmesh {
 
-uint32_t crc32(const uint8_t* data, size_t size);
+// `previous`: the CRC of bytes that come before `data`, so that a range can
+// be checksummed in pieces (0 for none).
+uint32_t crc32(const uint8_t* data, size_t size, uint32_t previous = 0);
 
 }  // namespace kdmesh

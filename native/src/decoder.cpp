@@ -126,7 +126,7 @@ struct Decoder::State {
   // `chunk`: the whole chunk, frameBytes of frame first.
   Status applyChunk(const uint8_t* chunk, size_t frameBytes, const ChunkFrame& frame) {
     const std::string where = "chunk " + std::to_string(chunks.size());
-    if (!chunkChecksumMatches(chunk, frameBytes + frame.payloadBytes))
+    if (!chunkChecksumMatches(chunk, frameBytes + frame.payloadBytes, uint32_t(chunks.size())))
       return Status::error(ErrorCode::CorruptChunk, where + ": checksum mismatch");
     coder.start(chunk + frameBytes, frame.payloadBytes);
     for (uint32_t left = frame.splitCount; left > 0;) {
@@ -484,6 +484,10 @@ struct Decoder::State {
       if (chunks.size() == header.chunkCount && !complete())
         status = Status::error(ErrorCode::CorruptChunk,
                                "the last chunk ends before the kd-tree is complete");
+      else if (chunks.size() == header.chunkCount && end != header.totalBytes())
+        status = Status::error(ErrorCode::CorruptChunk,
+                               "the last chunk ends at byte " + std::to_string(end) + ", the header announced " +
+                                   std::to_string(header.totalBytes()));
     }
     return status;
   }

@@ -88,7 +88,7 @@ class ChunkWriter {
     body_.erase(body_.begin() + std::ptrdiff_t(frameAt_ + frameBytes), body_.begin() + std::ptrdiff_t(payloadAt));
     const size_t checked = body_.size() - frameAt_;
     body_.resize(body_.size() + kChunkChecksumBytes);
-    writeChunkChecksum(body_.data() + frameAt_, checked, body_.data() + frameAt_ + checked);
+    writeChunkChecksum(body_.data() + frameAt_, checked, chunks_, body_.data() + frameAt_ + checked);
     ++chunks_;
     frameAt_ = body_.size();
   }

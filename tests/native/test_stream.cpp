@@ -184,7 +184,9 @@ TEST(Stream, CostsByLevelAddUpAndAgreeOnBothSides) {
     } else {
       EXPECT_GT(connectivityBits, 0.0);
     }
-    if (std::string(c.name).find("coincident") != std::string::npos) EXPECT_GT(mine.size(), size_t(h.depth()));
+    if (std::string(c.name).find("coincident") != std::string::npos) {
+      EXPECT_GT(mine.size(), size_t(h.depth()));
+    }
 
     ASSERT_GE(decoder.chunks().size(), 2u);
     const ChunkInfo& middle = decoder.chunks()[decoder.chunks().size() / 2];
@@ -229,6 +231,58 @@ TEST(Stream, TrailingBytesAreRefused) {
   EXPECT_EQ(decode(bytes.data(), bytes.size(), out).code, ErrorCode::TrailingBytes);
 }
 
+// Chunks swapped, dropped or repeated keep their own checksums but fail
+// them where they land: a chunk's checksum covers its index.
+TEST(Stream, ChunksOutOfPlaceAreCorrupt) {
+  const std::vector<uint8_t> bytes = sphereStream(3000, 256);
+  Decoder reference;
+  ASSERT_TRUE(reference.push(bytes.data(), bytes.size()).ok());
+  const std::vector<ChunkInfo>& chunks = reference.chunks();
+  ASSERT_GT(chunks.size(), 4u);
+  auto piece = [&](size_t i) {
+    const uint64_t end = i + 1 < chunks.size() ? chunks[i + 1].offset : bytes.size();
+    return std::vector<uint8_t>(bytes.begin() + std::ptrdiff_t(chunks[i].offset), bytes.begin() + std::ptrdiff_t(end));
+  };
+  for (size_t at = 0; at + 1 < chunks.size(); ++at) {
+    std::vector<uint8_t> swapped(bytes.begin(), bytes.begin() + std::ptrdiff_t(chunks[at].offset));
+    for (const size_t i : {at + 1, at})
+      for (const uint8_t b : piece(i)) swapped.push_back(b);
+    swapped.insert(swapped.end(), bytes.begin() + std::ptrdiff_t(swapped.size()), bytes.end());
+    ASSERT_EQ(swapped.size(), bytes.size());
+    Complex out;
+    EXPECT_EQ(decode(swapped.data(), swapped.size(), out).code, ErrorCode::CorruptChunk) << "swapped at " << at;
+    std::vector<uint8_t> repeated(bytes.begin(), bytes.begin() + std::ptrdiff_t(chunks[at + 1].offset));
+    for (const uint8_t b : piece(at)) repeated.push_back(b);
+    Decoder d;
+    EXPECT_EQ(d.push(repeated.data(), repeated.size()).code, ErrorCode::CorruptChunk) << "repeated at " << at;
+    std::vector<uint8_t> dropped(bytes.begin(), bytes.begin() + std::ptrdiff_t(chunks[at].offset));
+    dropped.insert(dropped.end(), bytes.begin() + std::ptrdiff_t(chunks[at + 1].offset), bytes.end());
+    EXPECT_EQ(decode(dropped.data(), dropped.size(), out).code, ErrorCode::CorruptChunk) << "dropped at " << at;
+  }
+}
+
+// A header announcing a longer body than its chunks fill is corrupt once
+// the last chunk is in, whatever bytes follow.
+TEST(Stream, ABodyLongerThanItsChunksIsCorrupt) {
+  const std::vector<uint8_t> bytes = sphereStream(3000, 256);
+  Header h;
+  size_t size = 0;
+  ASSERT_TRUE(headerSize(bytes.data(), size).ok());
+  ASSERT_TRUE(readHeader(bytes.data(), size, DecoderLimits{}, h).ok());
+  for (const uint64_t extra : {uint64_t(1), uint64_t(0xffffffffu) - h.bodyBytes}) {
+    Header longer = h;
+    longer.bodyBytes += extra;
+    uint8_t buffer[kMaxHeaderBytes];
+    std::vector<uint8_t> forged(buffer, buffer + writeHeader(longer, buffer));
+    forged.insert(forged.end(), bytes.begin() + std::ptrdiff_t(size), bytes.end());
+    forged.resize(forged.size() + 8, 0);
+    Decoder d;
+    const Status s = d.push(forged.data(), forged.size());
+    EXPECT_EQ(s.code, ErrorCode::CorruptChunk) << extra;
+    EXPECT_NE(s.message.find("the header announced"), std::string::npos) << s.message;
+  }
+}
+
 // Payloads replaced by noise with recomputed checksums: what a hostile server
 // could send. The decoder must refuse or decode a cloud of the declared
 // size, and never crash or read out of bounds (run under ASan in CI's fuzz job).
@@ -244,7 +298,7 @@ TEST(Stream, NoiseWithValidChecksumsNeverBreaksTheDecoder) {
       const size_t checked = c.frameBytes - kChunkChecksumBytes + c.payloadBytes;
       for (size_t i = c.frameBytes - kChunkChecksumBytes; i < checked; ++i)
         if (rng() % 4 == 0) chunk[i] = uint8_t(rng());
-      writeChunkChecksum(chunk, checked, chunk + checked);
+      writeChunkChecksum(chunk, checked, uint32_t(&c - reference.chunks().data()), chunk + checked);
     }
     Complex out;
     const Status s = decode(hostile.data(), hostile.size(), out);
@@ -287,6 +341,38 @@ TEST(Stream, HostileHeadersAreRefusedBeforeAnyAllocation) {
   Decoder d3;
   EXPECT_EQ(d3.push(buffer, size).code, ErrorCode::CorruptHeader);
 
+  // A grid whose far corner is no finite float32 would decode to infinities.
+  for (const double step : {1e38, 1e300}) {
+    h = validHeader();
+    h.step = step;
+    size = writeHeader(h, buffer);
+    Decoder far;
+    const Status s = far.push(buffer, size);
+    EXPECT_EQ(s.code, ErrorCode::CorruptHeader) << step;
+    EXPECT_NE(s.message.find("not a finite float32"), std::string::npos) << s.message;
+  }
+
+  // More vertices or simplices than the stream's size can justify (a
+  // 49-byte stream announcing 2^27 − 1 coincident points was a 3.7 GB
+  // decompression bomb); within the ratio DecoderLimits allows, accepted.
+  h = validHeader();
+  h.maxDimension = 0;
+  h.simplexCounts = {0, 0, 0, 0};
+  h.vertexCount = h.simplexCounts[0] = uint32_t(1024 * (h.bodyBytes + kMaxHeaderBytes)) + 1;
+  size = writeHeader(h, buffer);
+  Decoder bomb;
+  EXPECT_EQ(bomb.push(buffer, size).code, ErrorCode::LimitExceeded);
+  DecoderOptions generous;
+  generous.limits.maxVerticesPerByte = 2048;
+  Decoder raised(generous);
+  EXPECT_TRUE(raised.push(buffer, size).ok());
+  h = validHeader();
+  h.maxDimension = 2;
+  h.simplexCounts[2] = uint32_t(1024 * (h.bodyBytes + kMaxHeaderBytes)) + 1;
+  size = writeHeader(h, buffer);
+  Decoder simplexBomb;
+  EXPECT_EQ(simplexBomb.push(buffer, size).code, ErrorCode::LimitExceeded);
+
   const uint8_t text[] = "ply\nformat ascii 1.0\n";
   Decoder d4;
   EXPECT_EQ(d4.push(text, sizeof text).code, ErrorCode::BadMagic);
@@ -318,7 +404,7 @@ TEST(Stream, HeadersRoundTripWithTheirLargestValues) {
     h.simplexCounts = {h.vertexCount, 1u << 30, 1u << 30, 1u << 30};
     h.gridMax = {(1u << 30) - 1, 5, 0};
     h.origin = {-double(FLT_MAX), double(std::numeric_limits<float>::denorm_min()), 0};
-    h.step = 1e300;
+    h.step = 1e29;  // the far corner, origin + gridMax · step, still a finite float32
     h.floatImageMin = {0x00800000u, 0x7f000000u, 0x80000000u};
     h.bodyBytes = (uint64_t(1) << 62) - 1;
     h.chunkCount = 0xffffffffu;

@@ -231,6 +231,12 @@ struct DecoderLimits {
   uint32_t maxChunkBytes = 1u << 26;
   // Edges, triangles and tetrahedra of the complete complex, together.
   uint32_t maxSimplices = 1u << 28;
+  // Vertices and simplices per byte of the whole stream (header and body):
+  // what bounds the output a small stream can make. Honest streams take
+  // about a byte per vertex; only a cloud of many coincident points comes
+  // near the limit, which such a decoder raises.
+  uint64_t maxVerticesPerByte = 1024;
+  uint64_t maxSimplicesPerByte = 1024;
 };
 
 // Where snapshot() puts the vertex of a cell that is not yet a single grid
