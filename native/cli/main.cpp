@@ -34,12 +34,24 @@ void clearProgress() {
   gProgressShown = false;
 }
 
-// Error messages are one line, whatever the text they quote.
+// Error messages are one line, whatever the text they quote, and reach the
+// terminal without control characters: line breaks become spaces, the rest
+// (escape sequences, say) \xHH.
 std::string oneLine(std::string text) {
   while (!text.empty() && (text.back() == '\n' || text.back() == '\r')) text.pop_back();
-  for (char& c : text)
-    if (c == '\n' || c == '\r') c = ' ';
-  return text;
+  std::string out;
+  for (const char c : text) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (c == '\n' || c == '\r') {
+      out += ' ';
+    } else if (byte < 0x20 || byte == 0x7f) {
+      static constexpr char kHex[] = "0123456789abcdef";
+      out += {'\\', 'x', kHex[byte >> 4], kHex[byte & 15]};
+    } else {
+      out += c;
+    }
+  }
+  return out;
 }
 
 int fail(const std::string& message) {
@@ -413,7 +425,7 @@ int main(int argc, char** argv) {
     if (decode->parsed()) return runDecode(decodeArgs);
     return runInfo(infoInput, infoJson, infoLevels);
   } catch (const std::bad_alloc&) {
-    return fail("out of memory");
+    return fail(std::string("out of memory [") + kdmesh::errorCodeName(kdmesh::ErrorCode::LimitExceeded) + "]");
   } catch (const std::exception& e) {
     return fail(e.what());
   }

@@ -92,9 +92,10 @@ class CliTest : public ::testing::Test {
   // Runs the tool in the temporary directory with `args` (file names
   // relative to it). exec replaces the shell, so that a crash shows as a
   // signal rather than as the shell's exit code.
-  CliRun run(const std::string& args) const {
+  // `launcher`: a command that runs the CLI (say, /usr/bin/time), or none.
+  CliRun run(const std::string& args, const std::string& launcher = "") const {
     const std::string out = at("stdout.txt").string(), err = at("stderr.txt").string();
-    const std::string command = "cd '" + dir_.string() + "' && exec '" KDMESH_CLI_PATH "' " +
+    const std::string command = "cd '" + dir_.string() + "' && exec " + launcher + " '" KDMESH_CLI_PATH "' " +
                                 args + " <" "/dev/null >'" + out + "' 2>'" + err + "'";
     const int status = std::system(command.c_str());
     CliRun r;
@@ -373,6 +374,39 @@ TEST_F(CliTest, MissingMalformedAndUnknownInputsFailWithOneLine) {
   expectError("decode good.kdm -o noextension");
   expectError("decode cloud.xyz -o out.ply");  // not a kdmesh stream
   expectError("info cloud.xyz");
+}
+
+// A PLY or VTK file of another kind is refused after its first block: a
+// sparse 2 GB file, 'ply' not its first line, was read whole (2.3 GB
+// resident) before it was refused.
+TEST_F(CliTest, LargeFilesOfAnotherKindAreRefusedWithoutReadingThem) {
+  for (const char* name : {"big.ply", "big.vtk"}) {
+    SCOPED_TRACE(name);
+    writeWhole(at(name), "solid not really\n");
+    fs::resize_file(at(name), uintmax_t(2) << 30);  // sparse: no disk, no time
+    const CliRun r = run(std::string("encode ") + name + " -o x.kdm", "/usr/bin/time -f %M -o rss.txt");
+    EXPECT_EQ(r.exitCode, 1) << r.err;
+    EXPECT_NE(r.err.find("not a"), std::string::npos) << r.err;
+    // GNU time puts "Command exited with non-zero status 1" before the figure.
+    const std::string times = readWhole(at("rss.txt"));
+    const long residentKilobytes = std::stol(times.substr(times.find_last_of('\n', times.size() - 2) + 1));
+    EXPECT_GT(residentKilobytes, 500) << times;  // a process at all
+    EXPECT_LT(residentKilobytes, 256 << 10) << "peak resident memory";
+    fs::remove(at(name));
+  }
+}
+
+// The file's bytes in an error or a note are escaped: no terminal escape
+// sequence or control character reaches stderr.
+TEST_F(CliTest, FileBytesInMessagesAreEscaped) {
+  writeWhole(at("escape.xyz"), "1 2 3\n4 \x1b[31m\x07 6\n");
+  const std::string line = expectError("encode escape.xyz -o x.kdm");
+  EXPECT_NE(line.find("\\x1b[31m\\x07"), std::string::npos) << line;
+  writeWhole(at("escape.obj"), "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n\x1b]0;title\x07 x\n");
+  const CliRun r = runOk("encode escape.obj -o x.kdm");
+  EXPECT_NE(r.err.find("\\x1b]0;title\\x07"), std::string::npos) << r.err;
+  for (const std::string& output : {line, r.err, r.out})
+    for (const char c : output) EXPECT_FALSE((unsigned char)c < 0x20 && c != '\n' && c != '\r') << int(c);
 }
 
 TEST_F(CliTest, CorruptedAndTruncatedStreamsFailWithOneLine) {

@@ -172,10 +172,19 @@ Status readPositionLine(TextScanner& scanner, std::vector<float>& positions,
 
 std::string quoted(std::string_view token) {
   constexpr size_t kMaxShown = 40;
-  if (token.size() > kMaxShown) {
-    return "'" + std::string(token.substr(0, kMaxShown)) + "...'";
+  // A file's bytes go to a terminal: anything but printable ASCII is shown
+  // as \xHH, so no escape sequence or control character gets through.
+  std::string shown = "'";
+  for (const char c : token.substr(0, kMaxShown)) {
+    const auto byte = static_cast<unsigned char>(c);
+    if (byte >= 0x20 && byte < 0x7f && byte != '\\') {
+      shown += c;
+    } else {
+      static constexpr char kHex[] = "0123456789abcdef";
+      shown += {'\\', 'x', kHex[byte >> 4], kHex[byte & 15]};
+    }
   }
-  return "'" + std::string(token) + "'";
+  return shown + (token.size() > kMaxShown ? "...'" : "'");
 }
 
 bool equalsIgnoringCase(std::string_view a, std::string_view b) {

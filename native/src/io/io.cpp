@@ -94,10 +94,14 @@ std::string extensionOf(const std::string& path) {
   return extension;
 }
 
+// Checks the first bytes of a file before the rest is read.
+using HeadCheck = Status (*)(const uint8_t* head, size_t size);
+
 // Reads a whole file. `missing` tells whether it failed because the file
-// does not exist.
+// does not exist; `checkHead`, if given, sees the first block (64 KiB, or
+// the whole file if shorter) and can refuse the file before more is read.
 Status readWholeFile(const std::string& path, std::vector<uint8_t>& bytes,
-                     bool* missing = nullptr) {
+                     bool* missing = nullptr, HeadCheck checkHead = nullptr) {
   FilePtr file(std::fopen(path.c_str(), "rb"));
   if (!file) {
     if (missing) *missing = errno == ENOENT;
@@ -109,6 +113,8 @@ Status readWholeFile(const std::string& path, std::vector<uint8_t>& bytes,
   for (size_t block = 1 << 16;; block = std::min<size_t>(block * 2, 1 << 26)) {
     bytes.resize(used + block);
     const size_t got = std::fread(bytes.data() + used, 1, block, file.get());
+    if (used == 0 && checkHead && !std::ferror(file.get()))
+      if (Status status = checkHead(bytes.data(), got); !status.ok()) return status;
     used += got;
     if (got < block) break;
   }
@@ -286,7 +292,10 @@ Status readFile(const std::string& path, Complex& out, Notes& notes,
     return status;
   }
   std::vector<uint8_t> bytes;
-  if (Status status = readWholeFile(path, bytes); !status.ok()) return status;
+  const HeadCheck checkHead = format == Format::Ply   ? detail::checkPlySignature
+                              : format == Format::Vtk ? detail::checkVtkSignature
+                                                      : nullptr;
+  if (Status status = readWholeFile(path, bytes, nullptr, checkHead); !status.ok()) return status;
   return readMemory(format, bytes.data(), bytes.size(), out, notes, options);
 }
 

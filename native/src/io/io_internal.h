@@ -136,6 +136,11 @@ class TextOut {
 
 // Readers append to an empty `out`; readMemory clears it again on error.
 Status readPly(const uint8_t* data, size_t size, Complex& out, Notes& notes);
+// The first line of a PLY or legacy VTK file, checked on the file's first
+// bytes before the rest is read: a file of another kind is refused without
+// reading all of it.
+Status checkPlySignature(const uint8_t* head, size_t size);
+Status checkVtkSignature(const uint8_t* head, size_t size);
 Status readObj(const uint8_t* data, size_t size, Complex& out, Notes& notes);
 Status readOff(const uint8_t* data, size_t size, Complex& out, Notes& notes);
 Status readXyz(const uint8_t* data, size_t size, Complex& out, Notes& notes);

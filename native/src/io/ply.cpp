@@ -194,14 +194,21 @@ Status parsePropertyLine(TextScanner& scanner, PlyHeader& header) {
   return Status::success();
 }
 
-// Leaves the scanner on the end_header line, so that an ascii body can be
-// read on from there with the right line numbers.
-Status parseHeader(TextScanner& scanner, PlyHeader& header) {
+// The first line, 'ply' alone.
+Status readPlySignature(TextScanner& scanner) {
   std::string_view token;
   if (!scanner.nextLine() || !scanner.nextToken(token) || token != "ply" ||
       scanner.nextToken(token)) {
     return inputError("not a PLY file: the first line is not 'ply'");
   }
+  return Status::success();
+}
+
+// Leaves the scanner on the end_header line, so that an ascii body can be
+// read on from there with the right line numbers.
+Status parseHeader(TextScanner& scanner, PlyHeader& header) {
+  std::string_view token;
+  if (Status status = readPlySignature(scanner); !status.ok()) return status;
   bool hasFormat = false;
   while (scanner.nextLine()) {
     if (!scanner.nextToken(token) || token == "comment" ||
@@ -632,6 +639,11 @@ Status planElements(const PlyHeader& header, std::vector<ElementPlan>& plans,
 }
 
 }  // namespace
+
+Status checkPlySignature(const uint8_t* head, size_t size) {
+  TextScanner scanner(head, size);
+  return readPlySignature(scanner);
+}
 
 Status readPly(const uint8_t* data, size_t size, Complex& out, Notes& notes) {
   TextScanner scanner(data, size);

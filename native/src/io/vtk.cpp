@@ -102,6 +102,21 @@ struct Cells {
   uint64_t count() const { return offsets.size() - 1; }
 };
 
+// The first line, '# vtk DataFile Version x.x'.
+Status readVtkSignature(TextScanner& scanner) {
+  std::string_view token;
+  bool ok = scanner.nextLine();
+  for (std::string_view word : {"#", "vtk", "DataFile", "Version"}) {
+    ok = ok && scanner.nextToken(token) && equalsIgnoringCase(token, word);
+  }
+  if (!ok) {
+    return inputError(
+        "not a legacy VTK file: the first line is not "
+        "'# vtk DataFile Version x.x'");
+  }
+  return Status::success();
+}
+
 class VtkReader {
  public:
   VtkReader(const uint8_t* data, size_t size, Complex& out)
@@ -155,16 +170,8 @@ class VtkReader {
   }
 
   Status readPreamble() {
+    if (Status status = readVtkSignature(scanner_); !status.ok()) return status;
     std::string_view token;
-    bool ok = scanner_.nextLine();
-    for (std::string_view word : {"#", "vtk", "DataFile", "Version"}) {
-      ok = ok && scanner_.nextToken(token) && equalsIgnoringCase(token, word);
-    }
-    if (!ok) {
-      return inputError(
-          "not a legacy VTK file: the first line is not "
-          "'# vtk DataFile Version x.x'");
-    }
     if (!scanner_.nextLine() || !scanner_.nextContentLine()) {  // the title
       return inputError("VTK file ends before its ASCII or BINARY line");
     }
@@ -617,6 +624,11 @@ class VtkReader {
 };
 
 }  // namespace
+
+Status checkVtkSignature(const uint8_t* head, size_t size) {
+  TextScanner scanner(head, size);
+  return readVtkSignature(scanner);
+}
 
 Status readVtk(const uint8_t* data, size_t size, Complex& out, Notes& notes) {
   return VtkReader(data, size, out).read(notes);
