@@ -13,8 +13,8 @@ const viewer = (window.kdmeshViewer = {
   // Since the load began: the first and the last level drawn, and the last
   // level decoded.
   completeMs: null, finalRenderMs: null, levelsSeen: [], longTasks: [],
-  // Decoding workers still running (0 once a load has ended, however).
-  activeWorkers: () => loader.workers.size,
+  // Workers decoding a stream (0 once a load has ended, however).
+  activeWorkers: () => loader.busyWorkers,
   // Of the complete model, for tests to compare with a Node decode. Computed
   // when read: hashing the dragon's arrays takes ~60 ms, a long task the
   // page itself has no use for.
