@@ -630,7 +630,7 @@ export class KDMeshLoader extends Loader {
       if (finished) return;
       finished = true;
       this.#loads.delete(finish);
-      download.abort();
+      if (error) download.abort();  // a complete stream's response ends by itself
       // The worker's stream ended cleanly when it completed or reported bad data.
       if (worker) this.#release(worker, !error || error.fromWorker === true);
       view.release();
@@ -711,7 +711,7 @@ export class KDMeshLoader extends Loader {
         const reader = response.body.getReader();
         for (;;) {
           const { done, value } = await reader.read();
-          if (done || finished) break;
+          if (done) break;
           feed(value);
         }
       }
