@@ -63,6 +63,7 @@ void visitHeader(const kdmesh::Header& h, Field&& field) {
   field("step", Values{h.step});
   field("totalBytes", Values{double(h.totalBytes())});
   field("chunkCount", Values{double(h.chunkCount)});
+  field("depth", Values{double(h.depth())});  // kd-tree levels: the last level of a complete stream
 }
 
 template <class Field>

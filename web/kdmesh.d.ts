@@ -33,6 +33,8 @@ export interface Header {
   step: number;
   totalBytes: number;
   chunkCount: number;
+  /** Levels of the kd-tree: `progress.level` reaches it when the stream is complete. */
+  depth: number;
 }
 
 export interface Progress {

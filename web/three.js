@@ -683,21 +683,30 @@ export class KDMeshLoader extends Loader {
       }
     };
 
+    // The download starts at once; its first bytes wait in `early` while
+    // the WebAssembly compiles and a worker starts or frees up.
+    const early = [];
     const feed = (piece) => {
       if (finished) return;
       stats.bytesReceived += piece.length;
-      worker.postMessage({ type: 'bytes', bytes: piece }, [piece.buffer]);
+      if (worker) worker.postMessage({ type: 'bytes', bytes: piece }, [piece.buffer]);
+      else early.push(piece);
       progress(progressEvent());
     };
-    const stream = async () => {
-      const wasm = this.#compiledWasm();
-      const acquired = await this.#acquire();
+    const startWorker = async () => {
+      const [acquired, wasm] = await Promise.all([this.#acquire(), this.#compiledWasm()]);
       if (finished) return this.#release(acquired, true);
-      worker = acquired;
-      worker.onmessage = onMessage;
-      worker.onerror = (event) => finish(new KdmeshError('worker-failed', `the kdmesh worker failed: ${event.message || 'no message'}`));
+      acquired.onmessage = onMessage;
+      acquired.onerror = (event) => finish(new KdmeshError('worker-failed', `the kdmesh worker failed: ${event.message || 'no message'}`));
       const limits = options.limits ?? this.decoderLimits;
-      worker.postMessage({ type: 'start', wasm: await wasm, limits, tetrahedra: options.tetrahedra, geomorph: options.geomorph });
+      acquired.postMessage({ type: 'start', wasm, limits, tetrahedra: options.tetrahedra, geomorph: options.geomorph });
+      for (const piece of early) acquired.postMessage({ type: 'bytes', bytes: piece }, [piece.buffer]);
+      early.length = 0;
+      worker = acquired;
+    };
+    const stream = async () => {
+      const started = startWorker();
+      started.catch(finish);  // e.g. wasm-unavailable: fails the load without waiting for the download
       if (bytes) {
         feed(bytes);
       } else {
@@ -715,6 +724,7 @@ export class KDMeshLoader extends Loader {
           feed(value);
         }
       }
+      await started;
       if (!finished) worker.postMessage({ type: 'end' });
     };
     stream().catch((error) => finish(error instanceof KdmeshError || finished ? error

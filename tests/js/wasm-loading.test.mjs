@@ -23,6 +23,7 @@ test('the header and progress records read as the native CLI reports them', asyn
   assert.deepEqual(decoder.header, {
     vertexCount: info.vertexCount, maxDimension: info.maxDimension, simplexCounts: info.simplexCounts,
     quantization: info.quantization, bits: info.bits, step: info.step, totalBytes: info.bytes, chunkCount: info.chunks.length,
+    depth: info.axisBits.reduce((sum, bits) => sum + bits),
   });
   assert.equal(early.bytesReceived, 2000);
   assert.equal(early.bytesExpected, info.bytes);
@@ -38,6 +39,7 @@ test('the header and progress records read as the native CLI reports them', asyn
   assert.equal(final.complete, true);
   assert.equal(final.vertexCount, info.vertexCount);
   assert.equal(final.chunksApplied, info.chunks.length);
+  assert.equal(final.level, decoder.header.depth);
   assert.ok(final.errorBound <= info.step, `${final.errorBound} <= ${info.step}`);
   decoder.dispose();
 });
