@@ -15,7 +15,7 @@ import { createServer } from 'node:http';
 import { spawn } from 'node:child_process';
 import { createReadStream, existsSync, mkdtempSync, promises as fs, readdirSync, statSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
-import { dirname, extname, join, normalize, resolve, sep } from 'node:path';
+import { basename, dirname, extname, join, normalize, resolve, sep } from 'node:path';
 import { fileURLToPath } from 'node:url';
 
 const here = dirname(fileURLToPath(import.meta.url));
@@ -72,6 +72,14 @@ async function sendPaced(response, file, kbps) {
   response.end();
 }
 
+// The encoder's error for the page: the uploaded file's name instead of its
+// temporary path, without the CLI's prefix, and printable: the message may
+// quote bytes of a binary file.
+function encoderError(stderr, input, name) {
+  return stderr.split(input).join(name).replace(/kdmesh: error: /g, '')
+    .replace(/[^\x20-\x7e\n\u00a0-\ufffc]+/g, ' ').trim();
+}
+
 async function encode(request, response, name) {
   const cli = join(repo, 'build', 'kdmesh');
   const extension = extname(name).toLowerCase();
@@ -90,7 +98,7 @@ async function encode(request, response, name) {
   child.stderr.on('data', (d) => (stderr += d));
   child.on('close', async (code) => {
     if (code === 0) sendFile(response, output);
-    else response.writeHead(422, { 'content-type': 'text/plain' }).end(stderr.trim() || `kdmesh exited with ${code}`);
+    else response.writeHead(422, { 'content-type': 'text/plain; charset=utf-8' }).end(encoderError(stderr, input, basename(name)) || `kdmesh exited with ${code}`);
     response.on('close', () => fs.rm(work, { recursive: true, force: true }));
   });
 }
