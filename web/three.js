@@ -507,7 +507,8 @@ export class KDMeshLoader extends Loader {
   /** Decodes a whole stream already in memory. */
   parse(buffer, onLoad, onError) {
     const model = this.#createGroup();
-    this.#run(null, new Uint8Array(buffer).slice(), {}, new GroupView(model, this.uploads, {}));
+    const bytes = ArrayBuffer.isView(buffer) ? new Uint8Array(buffer.buffer, buffer.byteOffset, buffer.byteLength) : new Uint8Array(buffer);
+    this.#run(null, bytes.slice(), {}, new GroupView(model, this.uploads, {}));  // the worker takes the copy
     model.userData.loaded.then(() => onLoad?.(model), (error) => onError?.(error));
     return model;
   }
