@@ -31,3 +31,9 @@ test('the links of the shipped Markdown files resolve inside the package', () =>
   }
   assert.ok(links >= 5, `relative links checked: ${links}`);
 });
+
+test('the bundled worker is built from the current sources', async () => {
+  const { bundleWorker, workerSourcePath } = await import('../../scripts/bundle-worker.mjs');
+  assert.ok(readFileSync(workerSourcePath, 'utf8') === await bundleWorker(),
+    'web/dist/kdmesh-worker-source.js is older than web/kdmesh-worker.js or web/kdmesh.js: run sh scripts/build-wasm.sh');
+});
