@@ -233,3 +233,28 @@ test('parse() decodes bytes in memory, from an ArrayBuffer or a view of one', as
   assert.deepEqual(errors, []);
   await page.close();
 });
+
+test('preload() starts a worker that the first load then uses', async () => {
+  const { page, errors } = await openPage();
+  const result = await page.evaluate(async () => {
+    const loader = new KDMeshLoader();
+    const returned = loader.preload() === loader;
+    await new Promise((resolve) => {
+      const check = () => (loader.workers.size === 1 ? resolve() : setTimeout(check, 10));
+      check();
+    });
+    const [worker] = loader.workers;
+    const before = { workers: loader.workers.size, busy: loader.busyWorkers };
+    let during = null;
+    const model = loader.loadProgressive('models/fandisk.kdm', { onRefine: () => (during ??= { busy: loader.busyWorkers }) });
+    await model.userData.loaded;
+    const after = { workers: loader.workers.size, busy: loader.busyWorkers, same: [...loader.workers][0] === worker };
+    loader.dispose();
+    return { returned, before, during, after };
+  });
+  assert.deepEqual(result, {
+    returned: true, before: { workers: 1, busy: 0 }, during: { busy: 1 }, after: { workers: 1, busy: 0, same: true },
+  });
+  assert.deepEqual(errors, []);
+  await page.close();
+});
