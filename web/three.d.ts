@@ -70,6 +70,8 @@ export class KDMeshLoader extends Loader<Group> {
   materials: { surface: MeshStandardMaterial; lines: LineBasicMaterial; points: PointsMaterial };
   uploadBytesPerSlice: number;
   workerLimit: number;
+  /** Milliseconds after which an idle worker ends (default 10000). */
+  workerIdleTime: number;
   decoderLimits: DecoderLimits;
   /** Every worker started, busy or idle. */
   readonly workers: Set<Worker>;

@@ -370,6 +370,7 @@ class GeometryView {
 
 export class KDMeshLoader extends Loader {
   #idle = [];           // workers ready for a stream
+  #idleTimers = new Map();  // idle worker -> timer that ends it
   #waiting = [];        // loads waiting for a worker: functions that wake them
   #loads = new Set();   // loads in flight: functions that stop them with an error
   #wasm = null;         // Promise of the compiled WebAssembly module
@@ -381,6 +382,10 @@ export class KDMeshLoader extends Loader {
     this.wasmSource = undefined;
     this.workerUrl = null;
     this.workerLimit = 4;
+    // An idle worker ends after this many milliseconds: WebAssembly memory
+    // never shrinks, and a worker that decoded a large model holds all the
+    // memory it took until it ends.
+    this.workerIdleTime = 10000;
     this.decoderLimits = {};
     this.workers = new Set();  // every worker started, busy or idle
     // Bytes of a level sent to the GPU at a time, on renderers passed to
@@ -557,6 +562,8 @@ export class KDMeshLoader extends Loader {
     for (const wake of this.#waiting.splice(0)) wake();
     for (const worker of this.workers) worker.terminate();
     this.workers.clear();
+    for (const timer of this.#idleTimers.values()) clearTimeout(timer);
+    this.#idleTimers.clear();
     this.#idle = [];
     this.#workerScript?.then(({ url, revoke }) => revoke && URL.revokeObjectURL(url), () => {});
     this.uploads?.dispose();
@@ -589,7 +596,12 @@ export class KDMeshLoader extends Loader {
     const [script] = await Promise.all([this.#startWorker(), this.#compiledWasm()]);
     for (;;) {
       if (this.#disposed) throw new KdmeshError('disposed', 'the loader was disposed');
-      if (this.#idle.length) return this.#idle.pop();
+      if (this.#idle.length) {
+        const worker = this.#idle.pop();
+        clearTimeout(this.#idleTimers.get(worker));
+        this.#idleTimers.delete(worker);
+        return worker;
+      }
       if (this.workers.size < this.workerLimit) {
         const worker = new Worker(script.url, script.options);
         this.workers.add(worker);
@@ -605,6 +617,12 @@ export class KDMeshLoader extends Loader {
     worker.onmessage = worker.onerror = null;
     if (reusable && !this.#disposed) {
       this.#idle.push(worker);
+      this.#idleTimers.set(worker, setTimeout(() => {
+        this.#idle.splice(this.#idle.indexOf(worker), 1);
+        this.#idleTimers.delete(worker);
+        worker.terminate();
+        this.workers.delete(worker);
+      }, this.workerIdleTime));
     } else {
       worker.terminate();
       this.workers.delete(worker);

@@ -258,3 +258,23 @@ test('preload() starts a worker that the first load then uses', async () => {
   assert.deepEqual(errors, []);
   await page.close();
 });
+
+test('an idle worker ends after workerIdleTime', async () => {
+  const { page, errors } = await openPage();
+  const result = await page.evaluate(async () => {
+    const loader = new KDMeshLoader();
+    loader.workerIdleTime = 300;
+    await loader.loadProgressive('models/fandisk.kdm').userData.loaded;
+    const right = loader.workers.size;
+    // Reused within the idle time, the worker is kept.
+    await new Promise((resolve) => setTimeout(resolve, 150));
+    await loader.loadProgressive('models/fandisk.kdm').userData.loaded;
+    await new Promise((resolve) => setTimeout(resolve, 200));
+    const reused = loader.workers.size;
+    await new Promise((resolve) => setTimeout(resolve, 400));
+    return { right, reused, later: loader.workers.size };
+  });
+  assert.deepEqual(result, { right: 1, reused: 1, later: 0 });
+  assert.deepEqual(errors, []);
+  await page.close();
+});

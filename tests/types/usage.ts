@@ -37,6 +37,7 @@ export async function loading(renderer: WebGLRenderer): Promise<BufferGeometry> 
     .setWithCredentials(true)
     .setPath('/models/')
     .preload();
+  loader.workerIdleTime = 5000;
   const scene = new Scene();
   const camera = new PerspectiveCamera();
   await loader.prepareRenderer(renderer, camera, scene);
