@@ -4,7 +4,7 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { spawnSync } from 'node:child_process';
-import { mkdtempSync, readFileSync, writeFileSync } from 'node:fs';
+import { mkdirSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { join, dirname } from 'node:path';
 import { fileURLToPath } from 'node:url';
 import * as kdmesh from 'kdmesh';
@@ -18,9 +18,11 @@ test('a program using every export compiles with tsc --strict', () => {
   assert.equal(result.status, 0, result.stdout + result.stderr);
 });
 
-test('wrong uses of the declarations are type errors', () => {
+test('wrong uses of the declarations are type errors', (t) => {
   // Inside the repository, so that `kdmesh` resolves to this package.
+  mkdirSync(join(root, 'build'), { recursive: true });
   const dir = mkdtempSync(join(root, 'build', 'types-'));
+  t.after(() => rmSync(dir, { recursive: true, force: true }));
   writeFileSync(join(dir, 'wrong.ts'), [
     "import { decode } from 'kdmesh';",
     "import { KDMeshLoader } from 'kdmesh/three';",
