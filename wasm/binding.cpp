@@ -9,6 +9,7 @@
 #include <malloc.h>
 
 #include <cstdint>
+#include <initializer_list>
 #include <new>
 #include <vector>
 
@@ -22,10 +23,75 @@ struct KdmDecoder {
   std::vector<uint8_t> input;
   kdmesh::Complex snapshot;
   kdmesh::Status status;
+  // Decoder::errorBound() walks every current cell; it changes only when
+  // the header arrives or a chunk is applied, so it is kept until then.
+  int64_t boundKey = -2;  // -1: before the header, else chunks applied
+  double bound = 0;
 
   int remember(kdmesh::Status s) {
     status = std::move(s);
     return int(status.code);
+  }
+
+  double errorBound(const kdmesh::DecodeProgress& p) {
+    const int64_t key = decoder.hasHeader() ? int64_t(p.chunksApplied) : -1;
+    if (key != boundKey) {
+      bound = decoder.errorBound();
+      boundKey = key;
+    }
+    return bound;
+  }
+};
+
+// The records JavaScript reads as doubles. Each visit function names every
+// field once, beside its value: kdm_layout() describes the records from the
+// names, kdm_header() and kdm_progress() write the values in the same order,
+// and web/kdmesh.js builds its objects from the description. A field is
+// `name` (one value), `name[N]` (N values), `name:bool` (1 or 0) or
+// `name:a|b|...` (value i stands for the i-th word).
+using Values = std::initializer_list<double>;
+
+template <class Field>
+void visitHeader(const kdmesh::Header& h, Field&& field) {
+  field("vertexCount", Values{double(h.vertexCount)});
+  field("maxDimension", Values{double(h.maxDimension)});
+  field("simplexCounts[4]", Values{double(h.simplexCounts[0]), double(h.simplexCounts[1]),
+                                   double(h.simplexCounts[2]), double(h.simplexCounts[3])});
+  static_assert(int(kdmesh::Quantization::Grid) == 0 && int(kdmesh::Quantization::Float32) == 1);
+  field("quantization:grid|float32", Values{double(h.quantization)});
+  field("bits", Values{double(h.bits)});
+  field("step", Values{h.step});
+  field("totalBytes", Values{double(h.totalBytes())});
+  field("chunkCount", Values{double(h.chunkCount)});
+  field("depth", Values{double(h.depth())});  // kd-tree levels: the last level of a complete stream
+}
+
+template <class Field>
+void visitProgress(const kdmesh::DecodeProgress& p, double errorBound, Field&& field) {
+  field("bytesReceived", Values{double(p.bytesReceived)});
+  field("bytesConsumed", Values{double(p.bytesConsumed)});
+  field("bytesExpected", Values{double(p.bytesExpected)});
+  field("chunksApplied", Values{double(p.chunksApplied)});
+  field("level", Values{double(p.level)});
+  field("vertexCount", Values{double(p.cellCount)});
+  field("complete:bool", Values{p.complete ? 1.0 : 0.0});
+  field("errorBound", Values{errorBound});
+}
+
+// Appends the fields' names to a layout line.
+struct Describe {
+  char*& end;
+  void operator()(const char* name, Values) {
+    *end++ = ' ';
+    while (*name) *end++ = *name++;
+  }
+};
+
+// Writes the fields' values one after the other.
+struct Write {
+  double* out;
+  void operator()(const char*, Values values) {
+    for (double v : values) *out++ = v;
   }
 };
 
@@ -74,26 +140,27 @@ EMSCRIPTEN_KEEPALIVE const char* kdm_error_name(int code) {
 
 EMSCRIPTEN_KEEPALIVE int kdm_has_header(KdmDecoder* d) { return d->decoder.hasHeader(); }
 
-// Header fields into `out` (doubles): vertexCount, maxDimension, simplex
-// counts 0..3, quantization (0 grid, 1 float32), bits, step, totalBytes,
-// chunkCount.
-EMSCRIPTEN_KEEPALIVE void kdm_header(KdmDecoder* d, double* out) {
-  const kdmesh::Header& h = d->decoder.header();
-  const double fields[] = {double(h.vertexCount),      double(h.maxDimension),    double(h.simplexCounts[0]),
-                           double(h.simplexCounts[1]), double(h.simplexCounts[2]), double(h.simplexCounts[3]),
-                           double(h.quantization),     double(h.bits),            h.step,
-                           double(h.totalBytes()),     double(h.chunkCount)};
-  for (size_t i = 0; i < sizeof fields / sizeof fields[0]; ++i) out[i] = fields[i];
+// The records' layout, one line each: "header: FIELD ..." and
+// "progress: FIELD ...".
+EMSCRIPTEN_KEEPALIVE const char* kdm_layout() {
+  static char layout[512];  // the fields' names take about 250
+  if (!layout[0]) {
+    char* end = layout;
+    for (const char c : "header:") if (c) *end++ = c;
+    visitHeader(kdmesh::Header{}, Describe{end});
+    for (const char c : "\nprogress:") if (c) *end++ = c;
+    visitProgress(kdmesh::DecodeProgress{}, 0, Describe{end});
+  }
+  return layout;
 }
 
-// Progress into `out` (doubles): bytesReceived, bytesConsumed, bytesExpected,
-// chunksApplied, level, cellCount, complete, errorBound.
+// The header record into `out` (see kdm_layout).
+EMSCRIPTEN_KEEPALIVE void kdm_header(KdmDecoder* d, double* out) { visitHeader(d->decoder.header(), Write{out}); }
+
+// The progress record into `out` (see kdm_layout).
 EMSCRIPTEN_KEEPALIVE void kdm_progress(KdmDecoder* d, double* out) {
   const kdmesh::DecodeProgress p = d->decoder.progress();
-  const double fields[] = {double(p.bytesReceived), double(p.bytesConsumed), double(p.bytesExpected),
-                           double(p.chunksApplied), double(p.level),         double(p.cellCount),
-                           p.complete ? 1.0 : 0.0,  d->decoder.errorBound()};
-  for (size_t i = 0; i < sizeof fields / sizeof fields[0]; ++i) out[i] = fields[i];
+  visitProgress(p, d->errorBound(p), Write{out});
 }
 
 EMSCRIPTEN_KEEPALIVE void kdm_snapshot(KdmDecoder* d) { d->decoder.snapshot(d->snapshot); }

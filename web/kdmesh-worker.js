@@ -1,20 +1,21 @@
-// Module worker behind KDMeshLoader: decodes the stream off the main thread
-// and hands back snapshots as transferable arrays, one at a time, when the
-// page asks for the next one (so a fast network never floods the page).
+// The worker behind KDMeshLoader: decodes a stream off the main thread and
+// hands back snapshots as transferable arrays, one at a time, when the page
+// asks for the next one (so a fast network never floods the page). A worker
+// decodes one stream after another: the loader keeps a pool of them.
 //
-// Messages in:  {type: 'start', wasmSource?, tetrahedra?, geomorph?}, {type: 'bytes', bytes},
-//               {type: 'end'}, {type: 'next'} (the page is ready for a snapshot)
+// kdmesh/three runs it from web/dist/kdmesh-worker-source.js (this file
+// bundled into one classic script, see scripts/bundle-worker.mjs) through a
+// Blob URL, or as a module worker from a URL given to setWorkerUrl().
+//
+// Messages in:  {type: 'start', wasm (a WebAssembly.Module), limits?, tetrahedra?, geomorph?}
+//               (a new stream), {type: 'bytes', bytes}, {type: 'end'},
+//               {type: 'next'} (the page is ready for a snapshot)
 // Messages out: {type: 'header', header}, {type: 'snapshot', model} (the
 //               last one has model.complete), {type: 'error', code, message}
 import { createDecoder, setWasmSource } from './kdmesh.js';
 
-let decoder = null;
-let failed = false;
-let wanted = true;        // the page is ready for a snapshot
-let changed = false;      // chunks were applied since the last snapshot
-let headerSent = false;
-let wireframe = false;    // also send the edges of the tetrahedra
-let geomorph = false;     // also send every vertex's parent
+let wasmSet = false;
+let job = null;  // the stream being decoded (see start())
 
 // Faces of the tetrahedra that belong to exactly one: the visible surface of
 // a tetrahedral mesh, oriented outwards when the tetrahedra are positive.
@@ -106,7 +107,8 @@ function edgesOfTetrahedra(tetrahedra) {
 }
 
 function sendSnapshot() {
-  if (!decoder || !wanted || !changed) return;
+  const { decoder, wireframe, geomorph } = job;
+  if (!decoder || !job.wanted || !job.changed) return;
   const live = decoder.snapshot({ copy: false });  // views, valid until the next call on the decoder
   const boundary = live.tetrahedra.length ? boundaryOfTetrahedra(live.tetrahedra) : new Uint32Array(0);
   const tetrahedronEdges = live.tetrahedra.length && wireframe ? edgesOfTetrahedra(live.tetrahedra) : new Uint32Array(0);
@@ -127,42 +129,47 @@ function sendSnapshot() {
     parents: geomorph ? decoder.parents() : new Uint32Array(0),
     progress: decoder.progress,
   };
-  wanted = false;
-  changed = false;
+  job.wanted = false;
+  job.changed = false;
   const buffers = [positions, points, edges, triangles, model.tetrahedra, model.normals, model.parents]
     .map((a) => a.buffer).filter((b, i, all) => b.byteLength && all.indexOf(b) === i);
   postMessage({ type: 'snapshot', model }, buffers);
+  if (model.complete) end();
+}
+
+// The stream is over: the decoder's memory goes back to the worker's heap
+// for the next stream.
+function end() {
+  job.decoder?.dispose();
+  job.decoder = null;
+  job.done = true;
 }
 
 function fail(error) {
-  failed = true;
   postMessage({ type: 'error', code: error.code ?? 'error', message: error.message ?? String(error) });
-  decoder?.dispose();
-  decoder = null;
+  end();
 }
 
-// Received bytes wait here and are decoded one piece per task, so that the
-// page's 'next' requests are seen between pieces: the page gets refinements
-// while a fast download is still being decoded.
-const pending = [];
+// Received bytes wait in job.pending and are decoded one piece per task, so
+// that the page's 'next' requests are seen between pieces: the page gets
+// refinements while a fast download is still being decoded.
 const kSliceBytes = 16384;
-let ending = false;
-let pumping = false;
 
-function pump() {
-  pumping = false;
-  if (failed || !decoder) return;
+function pump(current) {
+  current.pumping = false;
+  if (current !== job || job.done || !job.decoder) return;
+  const { decoder, pending } = job;
   try {
     if (pending.length) {
       const before = decoder.progress.chunksApplied;
       decoder.push(pending.shift());
-      if (!headerSent && decoder.header) {
-        headerSent = true;
+      if (!job.headerSent && decoder.header) {
+        job.headerSent = true;
         postMessage({ type: 'header', header: decoder.header });
       }
-      if (decoder.progress.chunksApplied !== before) changed = true;
-    } else if (ending) {
-      ending = false;
+      if (decoder.progress.chunksApplied !== before) job.changed = true;
+    } else if (job.ending) {
+      job.ending = false;
       decoder.finish();
     }
     sendSnapshot();
@@ -170,44 +177,53 @@ function pump() {
     fail(error);
     return;
   }
-  if (pending.length || ending) schedule();
+  if (pending.length || job.ending) schedule();
 }
 
 function schedule() {
-  if (pumping) return;
-  pumping = true;
-  setTimeout(pump, 0);
+  if (job.pumping || !job.decoder) return;
+  job.pumping = true;
+  const current = job;
+  setTimeout(() => pump(current), 0);
+}
+
+async function start({ wasm, limits, tetrahedra, geomorph }) {
+  const current = (job = {
+    decoder: null, done: false, wanted: true, changed: false, headerSent: false, pending: [], ending: false, pumping: false,
+    wireframe: tetrahedra === 'wireframe',  // also send the edges of the tetrahedra
+    geomorph: Boolean(geomorph),            // also send every vertex's parent
+  });
+  try {
+    if (!wasmSet) {
+      setWasmSource(wasm);
+      wasmSet = true;
+    }
+    const decoder = await createDecoder({ limits });
+    if (current !== job) return decoder.dispose();
+    job.decoder = decoder;
+    schedule();
+  } catch (error) {
+    if (current === job) fail(error);
+  }
 }
 
 onmessage = ({ data }) => {
-  if (failed) return;
+  if (data.type === 'start') return start(data);
+  if (!job || job.done) return;
   switch (data.type) {
-    case 'start':
-      (async () => {
-        try {
-          if (data.wasmSource) setWasmSource(data.wasmSource);
-          wireframe = data.tetrahedra === 'wireframe';
-          geomorph = Boolean(data.geomorph);
-          decoder = await createDecoder(data.options ?? {});
-          schedule();
-        } catch (error) {
-          fail(error);
-        }
-      })();
-      break;
     case 'bytes':
       // Slices of at most 16 KiB: a large network read still yields
       // refinements (and the levels before a corrupt chunk) along the way.
-      for (let at = 0; at < data.bytes.length; at += kSliceBytes) pending.push(data.bytes.subarray(at, at + kSliceBytes));
-      if (decoder) schedule();
+      for (let at = 0; at < data.bytes.length; at += kSliceBytes) job.pending.push(data.bytes.subarray(at, at + kSliceBytes));
+      schedule();
       break;
     case 'end':
-      ending = true;
-      if (decoder) schedule();
+      job.ending = true;
+      schedule();
       break;
     case 'next':
-      wanted = true;
-      if (decoder) sendSnapshot();
+      job.wanted = true;
+      if (job.decoder) sendSnapshot();
       break;
   }
 };

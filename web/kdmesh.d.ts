@@ -2,10 +2,15 @@
 
 /** An error from the decoder. `code` is stable: 'bad-magic', 'unsupported-version',
  * 'corrupt-header', 'corrupt-chunk', 'truncated', 'trailing-bytes', 'limit-exceeded',
- * 'disposed', 'invalid-argument', 'out-of-memory' or 'wasm-unavailable'. */
+ * 'disposed', 'invalid-argument', 'out-of-memory' or 'wasm-unavailable'; from
+ * kdmesh/three also 'aborted', 'network' and 'worker-failed'. */
 export class KdmeshError extends Error {
+  constructor(code: string, message: string);
   readonly code: string;
 }
+
+/** Where the WebAssembly decoder can come from: a URL, the .wasm bytes or a compiled module. */
+export type WasmSource = string | URL | ArrayBuffer | ArrayBufferView | WebAssembly.Module;
 
 /** Caps on what a stream may ask for; exceeding one is a 'limit-exceeded' error. */
 export interface DecoderLimits {
@@ -28,6 +33,8 @@ export interface Header {
   step: number;
   totalBytes: number;
   chunkCount: number;
+  /** Levels of the kd-tree: `progress.level` reaches it when the stream is complete. */
+  depth: number;
 }
 
 export interface Progress {
@@ -74,8 +81,10 @@ export class Decoder {
   dispose(): void;
 }
 
-/** Where to load the WebAssembly decoder from (a URL, or the .wasm bytes). Default: embedded. */
-export function setWasmSource(source: string | URL | ArrayBuffer | ArrayBufferView): void;
+/** Where to load the WebAssembly decoder from. Default: the copy embedded in the package. */
+export function setWasmSource(source: WasmSource): void;
+/** Compiles the decoder (default source: setWasmSource's, else embedded); rejects with 'wasm-unavailable'. */
+export function compileWasm(source?: WasmSource): Promise<WebAssembly.Module>;
 export function createDecoder(options?: DecoderOptions): Promise<Decoder>;
 export function decode(bytes: Uint8Array | ArrayBuffer, options?: DecoderOptions): Promise<Model>;
 /** Bytes of WebAssembly heap in use (diagnostics). */

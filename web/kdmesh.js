@@ -27,10 +27,10 @@ let wasmSource;
 let modulePromise;
 
 /**
- * Where the WebAssembly decoder comes from: a URL (string or URL, fetched and
- * compiled with WebAssembly.instantiateStreaming), or the bytes of
- * kdmesh-wasm.wasm (ArrayBuffer or typed array). Call before the first
- * decoder is created; the default is the copy embedded in the package.
+ * Where the WebAssembly decoder comes from: a URL (string or URL), the bytes
+ * of kdmesh-wasm.wasm (ArrayBuffer or typed array), or a compiled
+ * WebAssembly.Module. Call before the first decoder is created; the default
+ * is the copy embedded in the package.
  */
 export function setWasmSource(source) {
   if (modulePromise) throw new KdmeshError('invalid-argument', 'setWasmSource must be called before the first decoder');
@@ -45,39 +45,91 @@ function base64Bytes(text) {
   return bytes;
 }
 
-async function instantiate(source) {
-  const options = {};
+async function compile(source) {
+  if (source instanceof WebAssembly.Module) return source;
   if (source === undefined) {
     const { wasmBase64 } = await import('./dist/kdmesh-wasm-binary.js');
-    options.wasmBinary = base64Bytes(wasmBase64);
-  } else if (source instanceof ArrayBuffer || ArrayBuffer.isView(source)) {
-    options.wasmBinary = source instanceof ArrayBuffer ? new Uint8Array(source) : source;
-  } else {
-    const url = String(source);
-    options.instantiateWasm = (imports, receive) => {
-      const response = fetch(url, { credentials: 'same-origin' });
-      const compiled = typeof WebAssembly.instantiateStreaming === 'function'
-        ? WebAssembly.instantiateStreaming(response, imports)
-        : response.then((r) => r.arrayBuffer()).then((b) => WebAssembly.instantiate(b, imports));
-      compiled.then((result) => receive(result.instance), (error) => { throw error; });
-      return {};
-    };
+    return WebAssembly.compile(base64Bytes(wasmBase64));
   }
-  return createKdmeshModule(options);
+  if (source instanceof ArrayBuffer || ArrayBuffer.isView(source)) return WebAssembly.compile(source);
+  const response = await fetch(String(source), { credentials: 'same-origin' });
+  if (!response.ok) throw new Error(`HTTP ${response.status} for ${response.url}`);
+  // Streaming compilation needs the wasm MIME type; other hosts get the bytes compiled.
+  if (typeof WebAssembly.compileStreaming === 'function' && response.headers.get('content-type') === 'application/wasm')
+    return WebAssembly.compileStreaming(response);
+  return WebAssembly.compile(await response.arrayBuffer());
+}
+
+/**
+ * Compiles the WebAssembly decoder from `source` (as for setWasmSource;
+ * default: the source set there, else the embedded copy). The module can be
+ * posted to workers, which then skip the download and the compilation.
+ * Rejects with a KdmeshError 'wasm-unavailable'.
+ */
+export async function compileWasm(source = wasmSource) {
+  try {
+    return await compile(source);
+  } catch (error) {
+    throw new KdmeshError('wasm-unavailable', `cannot load the kdmesh WebAssembly decoder: ${error.message ?? error}`);
+  }
+}
+
+// The Emscripten module running `wasm` (a WebAssembly.Module). Emscripten
+// reports only synchronous failures of an instantiateWasm hook, so an
+// asynchronous one rejects here.
+function instantiate(wasm) {
+  return new Promise((resolve, reject) => {
+    createKdmeshModule({
+      instantiateWasm(imports, receive) {
+        WebAssembly.instantiate(wasm, imports).then((instance) => receive(instance), reject);
+        return {};
+      },
+    }).then(resolve, reject);
+  });
+}
+
+// The records the C API writes as doubles, described by kdm_layout() (see
+// wasm/binding.cpp): for each record, its fields with their offsets.
+function parseLayout(text) {
+  const records = {};
+  for (const line of text.split('\n')) {
+    const colon = line.indexOf(':');
+    let offset = 0;
+    const fields = line.slice(colon + 1).trim().split(' ').map((spec) => {
+      const [, name, count, kind] = /^(\w+)(?:\[(\d+)\])?(?::(.+))?$/.exec(spec);
+      const field = { name, offset, count: Number(count ?? 1), words: kind && kind !== 'bool' ? kind.split('|') : null, bool: kind === 'bool' };
+      offset += field.count;
+      return field;
+    });
+    records[line.slice(0, colon)] = { fields, size: offset };
+  }
+  return records;
+}
+
+function readRecord({ fields }, values) {
+  const out = {};
+  for (const { name, offset, count, words, bool } of fields) {
+    const value = values[offset];
+    out[name] = count > 1 ? Array.from(values.subarray(offset, offset + count)) : bool ? value === 1 : words ? words[value] : value;
+  }
+  return out;
 }
 
 function loadModule() {
   if (!modulePromise) {
-    modulePromise = instantiate(wasmSource).catch((error) => {
-      modulePromise = undefined;
-      throw new KdmeshError('wasm-unavailable', `cannot load the kdmesh WebAssembly decoder: ${error.message ?? error}`);
-    });
+    modulePromise = compileWasm(wasmSource)
+      .then((wasm) => instantiate(wasm).catch((error) => {
+        throw new KdmeshError('wasm-unavailable', `cannot start the kdmesh WebAssembly decoder: ${error.message ?? error}`);
+      }))
+      .then((module) => Object.assign(module, { records: parseLayout(module.UTF8ToString(module._kdm_layout())) }))
+      .catch((error) => {
+        modulePromise = undefined;
+        throw error;
+      });
   }
   return modulePromise;
 }
 
-const HEADER_FIELDS = 11;
-const PROGRESS_FIELDS = 8;
 const EMPTY_INDICES = new Uint32Array(0);
 
 /** A progressive decoder; create it with createDecoder(). */
@@ -91,7 +143,7 @@ export class Decoder {
     this.#module = module;
     const limits = options.limits ?? {};
     this.#handle = module._kdm_create(limits.maxVertices >>> 0, limits.maxSimplices >>> 0, limits.maxChunkBytes >>> 0);
-    this.#scratch = module._malloc(8 * Math.max(HEADER_FIELDS, PROGRESS_FIELDS));
+    this.#scratch = module._malloc(8 * Math.max(module.records.header.size, module.records.progress.size));
     if (!this.#handle || !this.#scratch) throw new KdmeshError('out-of-memory', 'cannot allocate a decoder');
   }
 
@@ -138,34 +190,14 @@ export class Decoder {
     const m = this.#live();
     if (!m._kdm_has_header(this.#handle)) return null;
     m._kdm_header(this.#handle, this.#scratch);
-    const f = this.#doubles(HEADER_FIELDS);
-    return {
-      vertexCount: f[0],
-      maxDimension: f[1],
-      simplexCounts: [f[2], f[3], f[4], f[5]],
-      quantization: f[6] === 0 ? 'grid' : 'float32',
-      bits: f[7],
-      step: f[8],
-      totalBytes: f[9],
-      chunkCount: f[10],
-    };
+    return readRecord(m.records.header, this.#doubles(m.records.header.size));
   }
 
   /** { bytesReceived, bytesConsumed, bytesExpected, chunksApplied, level, vertexCount, complete, errorBound } */
   get progress() {
     const m = this.#live();
     m._kdm_progress(this.#handle, this.#scratch);
-    const f = this.#doubles(PROGRESS_FIELDS);
-    return {
-      bytesReceived: f[0],
-      bytesConsumed: f[1],
-      bytesExpected: f[2],
-      chunksApplied: f[3],
-      level: f[4],
-      vertexCount: f[5],
-      complete: f[6] === 1,
-      errorBound: f[7],
-    };
+    return readRecord(m.records.progress, this.#doubles(m.records.progress.size));
   }
 
   /**

@@ -15,7 +15,7 @@ import { createServer } from 'node:http';
 import { spawn } from 'node:child_process';
 import { createReadStream, existsSync, mkdtempSync, promises as fs, readdirSync, statSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
-import { dirname, extname, join, normalize, resolve, sep } from 'node:path';
+import { basename, dirname, extname, join, normalize, resolve, sep } from 'node:path';
 import { fileURLToPath } from 'node:url';
 
 const here = dirname(fileURLToPath(import.meta.url));
@@ -55,19 +55,29 @@ function sendFile(response, file) {
   createReadStream(file).pipe(response);
 }
 
-// Sends a file in 16 KiB slices at `kbps` kilobits per second.
+// Sends a file at `kbps` kilobits per second, in slices of 1 KiB or, at
+// rates where 1 KiB takes less than 20 ms, of 20 ms of transfer: a small
+// model reaches the page in enough pieces to refine step by step.
 async function sendPaced(response, file, kbps) {
   const bytes = await fs.readFile(file);
   response.writeHead(200, { 'content-type': 'application/octet-stream', 'content-length': bytes.length, 'cache-control': 'no-cache' });
-  const slice = 16384;
-  const bytesPerMs = (kbps * 1000) / 8 / 1000;
+  const bytesPerMs = kbps / 8;
+  const slice = Math.max(1024, Math.floor(20 * bytesPerMs));
   const start = Date.now();
   for (let at = 0; at < bytes.length && !response.destroyed; at += slice) {
-    const due = start + (at + slice) / bytesPerMs;
+    const due = start + Math.min(bytes.length, at + slice) / bytesPerMs;
     await new Promise((r) => setTimeout(r, Math.max(0, due - Date.now())));
     response.write(bytes.subarray(at, Math.min(bytes.length, at + slice)));
   }
   response.end();
+}
+
+// The encoder's error for the page: the uploaded file's name instead of its
+// temporary path, without the CLI's prefix, and printable: the message may
+// quote bytes of a binary file.
+function encoderError(stderr, input, name) {
+  return stderr.split(input).join(name).replace(/kdmesh: error: /g, '')
+    .replace(/[^\x20-\x7e\n\u00a0-\ufffc]+/g, ' ').trim();
 }
 
 async function encode(request, response, name) {
@@ -88,7 +98,7 @@ async function encode(request, response, name) {
   child.stderr.on('data', (d) => (stderr += d));
   child.on('close', async (code) => {
     if (code === 0) sendFile(response, output);
-    else response.writeHead(422, { 'content-type': 'text/plain' }).end(stderr.trim() || `kdmesh exited with ${code}`);
+    else response.writeHead(422, { 'content-type': 'text/plain; charset=utf-8' }).end(encoderError(stderr, input, basename(name)) || `kdmesh exited with ${code}`);
     response.on('close', () => fs.rm(work, { recursive: true, force: true }));
   });
 }

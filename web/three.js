@@ -1,22 +1,28 @@
-// kdmesh/three — a three.js loader for progressive .kdm streams.
+// kdmesh/three — a three.js loader for progressive .kdm streams, in the
+// idiom of three.js's own loaders (DRACOLoader).
 //
 //   import { KDMeshLoader } from 'kdmesh/three';
-//   const loader = new KDMeshLoader();
+//   const loader = new KDMeshLoader(manager);   // LoadingManager events, resolveURL, path
 //   const model = loader.loadProgressive(url, { onRefine(model, stats) {}, signal });
 //   scene.add(model);                 // usable at once, refined in place
 //   await model.userData.loaded;      // resolves when the last byte is applied
+//   const geometry = loader.loadGeometry(url);   // or a BufferGeometry, refined in place
 //
-// Decoding runs in a module worker; bytes are fed as fetch delivers them and
-// the geometry is refreshed at most once per animation frame. The returned
-// THREE.Group holds a Mesh (triangles, and the boundary of tetrahedra), a
-// LineSegments (edges) and a Points (isolated vertices), drawn with the
-// loader's `materials` (shared by every model it loads; change or replace
-// them before loading). `await loader.prepareRenderer(renderer, camera, scene)`
-// before streaming keeps the first refinements from blocking the page.
+// Decoding runs in a pool of workers (setWorkerLimit, default 4), started
+// from the worker's source bundled in the package, so no bundler needs
+// configuring; bytes are fed as fetch delivers them and the geometry is
+// refreshed at most once per animation frame. The THREE.Group of
+// loadProgressive/load/parse holds a Mesh (triangles, and the boundary of
+// tetrahedra), a LineSegments (edges) and a Points (isolated vertices),
+// drawn with the loader's `materials` (shared by every model it loads;
+// change or replace them before loading). `await
+// loader.prepareRenderer(renderer, camera, scene)` before streaming keeps
+// the first refinements from blocking the page.
 import {
   Box3, BufferAttribute, BufferGeometry, DoubleSide, Float32BufferAttribute, Group, LineBasicMaterial, LineSegments, Loader, Mesh,
   MeshStandardMaterial, Points, PointsMaterial, Scene, ShaderMaterial, Sphere, Vector3, WebGLRenderTarget,
 } from 'three';
+import { compileWasm, KdmeshError } from './kdmesh.js';
 
 // After the next frame, in a task of its own: a refinement applied inside
 // the frame's callbacks would lengthen the task that also draws it.
@@ -182,12 +188,206 @@ function createBuffersFromUsedBytes(gl) {
   };
 }
 
+// What a model's geometry draws from a level: its lists of simplices, each
+// [first list, elements of the second list stored right after it] (see the
+// worker's pack()), for the surface, the lines and the points.
+const listsOf = (model) => [
+  [model.triangles, model.boundary.length],
+  [model.edges, model.tetrahedronEdges.length],
+  [model.points, 0],
+];
+
+// A model as a THREE.Group of three objects (surface, lines, points) with
+// two sets of geometries: the level on screen is drawn from `front`; the
+// next one is staged in `back` and, on renderers passed to
+// prepareRenderer(), uploaded in slices by `uploaders`. With
+// options.geomorph, every vertex glides from where its ancestor was drawn at
+// the previous level to its new position over a few frames.
+class GroupView {
+  constructor(group, uploads, options) {
+    this.object = group;
+    this.objects = group.children;
+    this.uploads = uploads;
+    this.uploaders = uploads?.createUploaders() ?? [];
+    this.options = options;
+    this.front = new GeometrySet();
+    this.back = new GeometrySet();
+    this.objects.forEach((object, i) => {
+      object.geometry = this.front.geometries[i];
+      object.visible = false;  // until it has simplices
+    });
+    this.previous = null;     // { positions, count } of the last level drawn
+    this.morphTarget = null;  // { start, positions, count } for a geomorph of the level staged
+    this.morphId = 0;
+  }
+
+  // Draws `model` (after at least one frame); false when `stopped()` became
+  // true meanwhile.
+  async show(model, stopped) {
+    await nextFrame();  // at most one geometry update per frame
+    if (stopped()) return false;
+    this.#stageVertices(model);
+    this.#stageLists(model);
+    const { uploads, uploaders, back } = this;
+    if (uploads) {
+      uploaders.forEach((object, i) => (object.geometry = back.geometries[i]));
+      while (back.pending) {
+        if (uploads.gpu.passed()) {
+          back.mark(uploads.bytesPerSlice);
+          uploads.run(uploaders);
+        }
+        await nextFrame();
+        if (stopped()) return false;
+      }
+    } else {
+      back.mark(Infinity);  // uploaded when first drawn
+    }
+    this.#swap(model);
+    return true;
+  }
+
+  // The set not on screen holds an older level's GPU buffers.
+  release() {
+    for (const geometry of this.back.geometries) geometry.dispose();
+  }
+
+  #stageVertices(model) {
+    const { options, back } = this;
+    let drawn = storageOf(model.positions);
+    this.morphTarget = null;
+    if (options.geomorph && this.previous) {
+      const previous = this.previous;
+      drawn = new Float32Array(drawn.length);  // moves between the levels; model.positions stays
+      for (let v = 0; v < model.vertexCount; ++v) {
+        let ancestor = v;
+        while (ancestor >= previous.count) ancestor = model.parents[ancestor];
+        drawn[3 * v] = previous.positions[3 * ancestor];
+        drawn[3 * v + 1] = previous.positions[3 * ancestor + 1];
+        drawn[3 * v + 2] = previous.positions[3 * ancestor + 2];
+      }
+      this.morphTarget = { start: drawn.slice(0, model.positions.length), positions: model.positions, count: model.vertexCount };
+    }
+    if (options.geomorph) this.previous = { positions: model.positions, count: model.vertexCount };
+    const position = back.stage('position', 0, drawn, model.positions.length, 3);
+    back.geometries[1].setAttribute('position', position);
+    back.geometries[2].setAttribute('position', position);
+    // Normals come from the worker. On the final dragon (871k triangles,
+    // Node 20) the worker's loop takes 90 ms and three.js's
+    // computeVertexNormals 140 ms, which would block the main thread.
+    if (model.normals.length) back.stage('normal', 0, storageOf(model.normals), model.normals.length, 3);
+  }
+
+  #stageLists(model) {
+    // One bounding volume from the current vertices (the worker's) serves
+    // all three objects.
+    const box = new Box3().setFromArray(model.bounds);
+    const sphere = box.getBoundingSphere(new Sphere());
+    listsOf(model).forEach(([first, more], i) => {
+      const count = first.length + more;
+      if (count) this.back.stage('index', i, storageOf(first), count, 1);
+      const geometry = this.back.geometries[i];
+      geometry.boundingBox = box.clone();
+      geometry.boundingSphere = sphere.clone();
+    });
+  }
+
+  // The staged level goes on screen; the set it replaces takes the next.
+  #swap(model) {
+    [this.front, this.back] = [this.back, this.front];
+    listsOf(model).forEach(([first, more], i) => {
+      const count = first.length + more;
+      this.front.geometries[i].setDrawRange(0, count);
+      this.objects[i].geometry = this.front.geometries[i];
+      this.objects[i].visible = count > 0;
+    });
+    const position = this.front.geometries[0].getAttribute('position');
+    if (this.morphTarget) this.#morph(position, this.morphTarget);
+    else this.morphId += 1;  // a level drawn at once ends any morph in flight
+  }
+
+  // The three objects share one position attribute, so one update moves them all.
+  #morph(attribute, { start, positions, count }) {
+    const id = ++this.morphId;
+    const frames = this.options.geomorphFrames ?? 12;
+    let frame = 0;
+    const step = () => {
+      if (id !== this.morphId) return;
+      frame += 1;
+      const t = frame / frames;
+      const array = attribute.array;
+      for (let i = 0; i < 3 * count; ++i) array[i] = start[i] + t * (positions[i] - start[i]);
+      attribute.needsUpdate = true;
+      this.options.onAnimate?.(this.object);
+      if (frame < frames) requestAnimationFrame(step);
+    };
+    requestAnimationFrame(step);
+  }
+}
+
+// A model as one BufferGeometry, refined in place, for the page's own
+// material and object: its index holds the triangles (with the boundary of
+// tetrahedra) when the complete model has any, else its edges; a point
+// cloud has no index. userData.primitive ('triangles', 'lines' or
+// 'points') says which, once the header has arrived.
+class GeometryView {
+  constructor(geometry) {
+    this.object = geometry;
+    this.list = -1;  // which of listsOf() the index holds (-1: none)
+  }
+
+  header(header) {
+    const [, edges, triangles, tetrahedra] = header.simplexCounts;
+    this.list = triangles + tetrahedra > 0 ? 0 : edges > 0 ? 1 : -1;
+    this.object.userData.primitive = ['triangles', 'lines'][this.list] ?? 'points';
+  }
+
+  async show(model, stopped) {
+    await nextFrame();
+    if (stopped()) return false;
+    const geometry = this.object;
+    const update = (name, storage, used, itemSize) => {
+      const attribute = adoptAttribute(geometry, name, storage, itemSize);
+      attribute.clearUpdateRanges();
+      attribute.addUpdateRange(0, used);
+      attribute.needsUpdate = true;
+    };
+    update('position', storageOf(model.positions), model.positions.length, 3);
+    if (model.normals.length) update('normal', storageOf(model.normals), model.normals.length, 3);
+    let count = model.vertexCount;
+    if (this.list >= 0) {
+      const [first, more] = listsOf(model)[this.list];
+      count = first.length + more;
+      if (count) update('index', storageOf(first), count, 1);
+    }
+    geometry.setDrawRange(0, count);
+    geometry.boundingBox = new Box3().setFromArray(model.bounds);
+    geometry.boundingSphere = geometry.boundingBox.getBoundingSphere(new Sphere());
+    return true;
+  }
+
+  release() {}
+}
+
 export class KDMeshLoader extends Loader {
+  #idle = [];           // workers ready for a stream
+  #idleTimers = new Map();  // idle worker -> timer that ends it
+  #waiting = [];        // loads waiting for a worker: functions that wake them
+  #loads = new Set();   // loads in flight: functions that stop them with an error
+  #wasm = null;         // Promise of the compiled WebAssembly module
+  #workerScript = null; // Promise of { url, options } to start workers with
+  #disposed = false;
+
   constructor(manager) {
     super(manager);
     this.wasmSource = undefined;
-    this.workerUrl = new URL('./kdmesh-worker.js', import.meta.url);
-    this.workers = new Set();
+    this.workerUrl = null;
+    this.workerLimit = 4;
+    // An idle worker ends after this many milliseconds: WebAssembly memory
+    // never shrinks, and a worker that decoded a large model holds all the
+    // memory it took until it ends.
+    this.workerIdleTime = 10000;
+    this.decoderLimits = {};
+    this.workers = new Set();  // every worker started, busy or idle
     // Bytes of a level sent to the GPU at a time, on renderers passed to
     // prepareRenderer() (see SlicedUploads).
     this.uploadBytesPerSlice = 4 << 20;
@@ -197,6 +397,11 @@ export class KDMeshLoader extends Loader {
       lines: new LineBasicMaterial({ color: 0x33475b }),
       points: new PointsMaterial({ color: 0x1f6feb, size: 2, sizeAttenuation: false }),
     };
+  }
+
+  /** Workers decoding a stream now. */
+  get busyWorkers() {
+    return this.workers.size - this.#idle.length;
   }
 
   /**
@@ -255,44 +460,69 @@ export class KDMeshLoader extends Loader {
     return group;
   }
 
-  /** Self-hosting: where the worker loads kdmesh-wasm.wasm from (default: embedded). */
+  /** Self-hosting: the workers load kdmesh-wasm.wasm from this folder (default: the copy embedded in the package). */
   setDecoderPath(path) {
-    this.wasmSource = new URL('kdmesh-wasm.wasm', new URL(path, globalThis.location?.href)).href;
+    return this.setWasmSource(new URL('kdmesh-wasm.wasm', new URL(path, globalThis.location?.href)).href);
+  }
+
+  /** Where the decoder's WebAssembly comes from: a URL, the .wasm bytes or a WebAssembly.Module. */
+  setWasmSource(source) {
+    this.wasmSource = source;
+    this.#wasm = null;
     return this;
   }
 
-  /** Where the decoding worker script lives (default: next to this module). */
+  /**
+   * Starts workers as module workers from this URL (web/kdmesh-worker.js,
+   * exported as kdmesh/worker, next to kdmesh.js and dist/) instead of from
+   * the source bundled in the package through a Blob URL: for pages whose
+   * Content-Security-Policy refuses blob: workers.
+   */
   setWorkerUrl(url) {
     this.workerUrl = url;
+    this.#workerScript = null;
+    return this;
+  }
+
+  /** How many workers decode at once; further loads wait for one (default 4). */
+  setWorkerLimit(limit) {
+    this.workerLimit = Math.max(1, limit);
+    return this;
+  }
+
+  /** Caps for every decoder: { maxVertices, maxSimplices, maxChunkBytes }; a stream beyond one fails with 'limit-exceeded'. */
+  setDecoderLimits(limits) {
+    this.decoderLimits = { ...limits };
+    return this;
+  }
+
+  /** Compiles the decoder and starts a worker now, so that the first load need not wait for them. */
+  preload() {
+    this.#acquire().then((worker) => this.#release(worker, true), () => {});
     return this;
   }
 
   /** three.js loader interface: onLoad receives the group once complete. */
   load(url, onLoad, onProgress, onError) {
-    const model = this.loadProgressive(url, {
-      onProgress: (stats) => onProgress?.({ loaded: stats.bytesReceived, total: stats.bytesExpected, lengthComputable: stats.bytesExpected > 0 }),
-    });
-    model.userData.loaded.then(() => onLoad?.(model), (error) => (onError ? onError(error) : this.manager.itemError(url)));
+    const model = this.loadProgressive(url, { onProgress: onProgress && ((stats, event) => onProgress(event)) });
+    model.userData.loaded.then(() => onLoad?.(model), (error) => onError?.(error));
     return model;
-  }
-
-  loadAsync(url, onProgress) {
-    return new Promise((resolve, reject) => this.load(url, resolve, onProgress, reject));
   }
 
   /** Decodes a whole stream already in memory. */
   parse(buffer, onLoad, onError) {
-    const model = this.#start({});
-    model.userData.feed(new Uint8Array(buffer).slice());  // the worker takes the copy
-    model.userData.end();
-    model.userData.loaded.then(() => onLoad?.(model), onError);
+    const model = this.#createGroup();
+    const bytes = ArrayBuffer.isView(buffer) ? new Uint8Array(buffer.buffer, buffer.byteOffset, buffer.byteLength) : new Uint8Array(buffer);
+    this.#run(null, bytes.slice(), {}, new GroupView(model, this.uploads, {}));  // the worker takes the copy
+    model.userData.loaded.then(() => onLoad?.(model), (error) => onError?.(error));
     return model;
   }
 
   /**
    * Starts streaming `url` and returns the group at once. Options: onRefine(model,
-   * stats) after each refinement, onHeader(header), onProgress(stats),
+   * stats) after each refinement, onHeader(header), onProgress(stats, event),
    * signal (AbortSignal: stops the download and keeps the current level),
+   * limits (decoder caps, default setDecoderLimits'),
    * tetrahedra: 'boundary' (default: the faces in exactly one tetrahedron) or
    * 'wireframe' (the boundary plus every edge of the tetrahedra), geomorph
    * (true: new vertices glide from their parent's position over
@@ -300,202 +530,223 @@ export class KDMeshLoader extends Loader {
    * changes between refinements (geomorph frames).
    */
   loadProgressive(url, options = {}) {
-    const model = this.#start(options);
-    const { feed, end, fail } = model.userData;
-    const stream = async () => {
-      const response = await fetch(this.path ? this.path + url : url, { signal: options.signal, credentials: this.withCredentials ? 'include' : 'same-origin' });
-      if (!response.ok) throw new Error(`${url}: HTTP ${response.status}`);
-      const reader = response.body.getReader();
-      for (;;) {
-        const { done, value } = await reader.read();
-        if (done) break;
-        feed(value);
-      }
-      end();
-    };
-    stream().catch((error) => fail(error));
+    const model = this.#createGroup();
+    this.#run(url, null, options, new GroupView(model, this.uploads, options));
     return model;
   }
 
-  #start(options) {
-    const worker = new Worker(this.workerUrl, { type: 'module' });
-    this.workers.add(worker);
-    const group = this.#createGroup();
-    const [surface, lines, points] = group.children;
-    for (const object of group.children) object.visible = false;  // until it has simplices
+  /**
+   * Like loadProgressive, but returns one BufferGeometry, refined in place,
+   * for a material and object of the page's choice (see GeometryView):
+   * geometry.userData has loaded, stats and primitive. No geomorphs.
+   */
+  loadGeometry(url, options = {}) {
+    const geometry = new BufferGeometry();
+    this.#run(url, null, options, new GeometryView(geometry));
+    return geometry;
+  }
 
+  /** Stops every load in flight; each keeps its current level and rejects with code 'aborted'. */
+  abort() {
+    for (const stop of [...this.#loads]) stop(new KdmeshError('aborted', 'the load was aborted'));
+    return this;
+  }
+
+  /**
+   * Stops every load in flight (rejecting with code 'disposed'), ends the
+   * workers and frees the materials; the loader is unusable after.
+   */
+  dispose() {
+    this.#disposed = true;
+    for (const stop of [...this.#loads]) stop(new KdmeshError('disposed', 'the loader was disposed'));
+    for (const wake of this.#waiting.splice(0)) wake();
+    for (const worker of this.workers) worker.terminate();
+    this.workers.clear();
+    for (const timer of this.#idleTimers.values()) clearTimeout(timer);
+    this.#idleTimers.clear();
+    this.#idle = [];
+    this.#workerScript?.then(({ url, revoke }) => revoke && URL.revokeObjectURL(url), () => {});
+    this.uploads?.dispose();
+    for (const material of Object.values(this.materials)) material.dispose();
+    return this;
+  }
+
+  #compiledWasm() {
+    if (!this.#wasm) {
+      this.#wasm = compileWasm(this.wasmSource);
+      this.#wasm.catch(() => (this.#wasm = null));  // a later load tries again
+    }
+    return this.#wasm;
+  }
+
+  #startWorker() {
+    if (!this.#workerScript) {
+      this.#workerScript = this.workerUrl
+        ? Promise.resolve({ url: this.workerUrl, options: { type: 'module' }, revoke: false })
+        : import('./dist/kdmesh-worker-source.js').then(({ workerSource }) => ({
+          url: URL.createObjectURL(new Blob([workerSource], { type: 'text/javascript' })), options: {}, revoke: true,
+        }));
+    }
+    return this.#workerScript;
+  }
+
+  // An idle worker, a new one while fewer than workerLimit run, or the next
+  // one released.
+  async #acquire() {
+    const [script] = await Promise.all([this.#startWorker(), this.#compiledWasm()]);
+    for (;;) {
+      if (this.#disposed) throw new KdmeshError('disposed', 'the loader was disposed');
+      if (this.#idle.length) {
+        const worker = this.#idle.pop();
+        clearTimeout(this.#idleTimers.get(worker));
+        this.#idleTimers.delete(worker);
+        return worker;
+      }
+      if (this.workers.size < this.workerLimit) {
+        const worker = new Worker(script.url, script.options);
+        this.workers.add(worker);
+        return worker;
+      }
+      await new Promise((wake) => this.#waiting.push(wake));
+    }
+  }
+
+  // A worker whose stream ended cleanly decodes the next; one stopped
+  // mid-stream is ended.
+  #release(worker, reusable) {
+    worker.onmessage = worker.onerror = null;
+    if (reusable && !this.#disposed) {
+      this.#idle.push(worker);
+      this.#idleTimers.set(worker, setTimeout(() => {
+        this.#idle.splice(this.#idle.indexOf(worker), 1);
+        this.#idleTimers.delete(worker);
+        worker.terminate();
+        this.workers.delete(worker);
+      }, this.workerIdleTime));
+    } else {
+      worker.terminate();
+      this.workers.delete(worker);
+    }
+    this.#waiting.shift()?.();
+  }
+
+  // Streams `url` (or decodes `bytes`) into `view`, whose object gets
+  // userData { stats, loaded }.
+  #run(url, bytes, options, view) {
     const stats = { refinements: 0, bytesReceived: 0, bytesExpected: 0, header: null, complete: false, model: null };
     let settle;
     const loaded = new Promise((resolve, reject) => (settle = { resolve, reject }));
     loaded.catch(() => {});  // callers that only watch events need not handle it
+    Object.assign(view.object.userData, { stats, loaded });
+
+    const resolved = url === null ? null : this.manager.resolveURL((this.path ?? '') + url);
+    if (resolved !== null) this.manager.itemStart(resolved);
+    const download = new AbortController();
+    let worker = null;
     let finished = false;
+    const stopped = () => finished;
     const finish = (error) => {
       if (finished) return;
       finished = true;
-      worker.terminate();
-      this.workers.delete(worker);
-      // The set not on screen holds an older level's GPU buffers.
-      for (const geometry of back.geometries) geometry.dispose();
-      if (error) settle.reject(error);
-      else settle.resolve(group);
-    };
-
-    // Geomorphs: every vertex glides from where its ancestor was drawn at
-    // the previous level to its new position over a few frames. The three
-    // objects share one position attribute, so one update moves them all.
-    let previous = null;  // { positions, count } of the last level drawn
-    let morphId = 0;
-    const morph = (attribute, from, to, count) => {
-      const id = ++morphId;
-      const frames = options.geomorphFrames ?? 12;
-      let frame = 0;
-      const step = () => {
-        if (id !== morphId) return;
-        frame += 1;
-        const t = frame / frames;
-        const array = attribute.array;
-        for (let i = 0; i < 3 * count; ++i) array[i] = from[i] + t * (to[i] - from[i]);
-        attribute.needsUpdate = true;
-        options.onAnimate?.(group);
-        if (frame < frames) requestAnimationFrame(step);
-      };
-      requestAnimationFrame(step);
-    };
-
-    // The level on screen is drawn from `front`; the next one is staged in
-    // `back` and, on prepared renderers, uploaded by `uploaders` in slices.
-    let front = new GeometrySet();
-    let back = new GeometrySet();
-    const uploads = this.uploads;
-    const uploaders = uploads?.createUploaders() ?? [];
-    const objects = group.children;
-    objects.forEach((object, i) => (object.geometry = front.geometries[i]));
-
-    let morphTarget = null;  // { start, positions, count } for a geomorph of the level staged
-    const stageVertices = (model) => {
-      let drawn = storageOf(model.positions);
-      morphTarget = null;
-      if (options.geomorph && previous) {
-        drawn = new Float32Array(drawn.length);  // moves between the levels; model.positions stays
-        for (let v = 0; v < model.vertexCount; ++v) {
-          let ancestor = v;
-          while (ancestor >= previous.count) ancestor = model.parents[ancestor];
-          drawn[3 * v] = previous.positions[3 * ancestor];
-          drawn[3 * v + 1] = previous.positions[3 * ancestor + 1];
-          drawn[3 * v + 2] = previous.positions[3 * ancestor + 2];
-        }
-        morphTarget = { start: drawn.slice(0, model.positions.length), positions: model.positions, count: model.vertexCount };
+      this.#loads.delete(finish);
+      if (error) download.abort();  // a complete stream's response ends by itself
+      // The worker's stream ended cleanly when it completed or reported bad data.
+      if (worker) this.#release(worker, !error || error.fromWorker === true);
+      view.release();
+      if (resolved !== null) {
+        if (error) this.manager.itemError(resolved);
+        this.manager.itemEnd(resolved);
       }
-      if (options.geomorph) previous = { positions: model.positions, count: model.vertexCount };
-      const position = back.stage('position', 0, drawn, model.positions.length, 3);
-      back.geometries[1].setAttribute('position', position);
-      back.geometries[2].setAttribute('position', position);
-      // Normals come from the worker. On the final dragon (871k triangles,
-      // Node 20) the worker's loop takes 90 ms and three.js's
-      // computeVertexNormals 140 ms, which would block the main thread.
-      if (model.normals.length) back.stage('normal', 0, storageOf(model.normals), model.normals.length, 3);
+      if (error) settle.reject(error);
+      else settle.resolve(view.object);
     };
-    // Lists drawn together lie one after the other in one storage (see the worker).
-    const listsOf = (model) => [
-      [model.triangles, model.boundary.length],
-      [model.edges, model.tetrahedronEdges.length],
-      [model.points, 0],
-    ];
-    const stageLists = (model) => {
-      // One bounding volume from the current vertices (the worker's) serves
-      // all three objects.
-      const box = new Box3().setFromArray(model.bounds);
-      const sphere = box.getBoundingSphere(new Sphere());
-      listsOf(model).forEach(([first, more], i) => {
-        const count = first.length + more;
-        if (count) back.stage('index', i, storageOf(first), count, 1);
-        const geometry = back.geometries[i];
-        geometry.boundingBox = box.clone();
-        geometry.boundingSphere = sphere.clone();
-      });
+    this.#loads.add(finish);
+    const signals = [options.signal, this.manager.abortController?.signal].filter(Boolean);
+    for (const signal of signals) {
+      if (signal.aborted) finish(new KdmeshError('aborted', 'the load was aborted'));
+      else signal.addEventListener('abort', () => finish(new KdmeshError('aborted', 'the load was aborted')), { once: true });
+    }
+
+    const progress = (event) => {
+      options.onProgress?.(stats, event);
     };
-    // The staged level goes on screen; the set it replaces takes the next.
-    const swap = (model) => {
-      [front, back] = [back, front];
-      listsOf(model).forEach(([first, more], i) => {
-        const count = first.length + more;
-        front.geometries[i].setDrawRange(0, count);
-        objects[i].geometry = front.geometries[i];
-        objects[i].visible = count > 0;
-      });
-      const position = front.geometries[0].getAttribute('position');
-      if (morphTarget) morph(position, morphTarget.start, morphTarget.positions, morphTarget.count);
-      else morphId += 1;  // a level drawn at once ends any morph in flight
+    const progressEvent = () => {
+      const init = { lengthComputable: stats.bytesExpected > 0, loaded: stats.bytesReceived, total: stats.bytesExpected };
+      return typeof ProgressEvent === 'function' ? new ProgressEvent('progress', init) : init;
     };
 
     // A snapshot waits for the next frame; an error that arrives meanwhile
     // is reported after it is drawn, so the last good level stays on screen.
     let drawing = Promise.resolve();
     const draw = async (model) => {
-      await nextFrame();  // at most one geometry update per frame
-      if (finished) return;
-      stageVertices(model);
-      stageLists(model);
-      if (uploads) {
-        uploaders.forEach((object, i) => (object.geometry = back.geometries[i]));
-        while (back.pending) {
-          if (uploads.gpu.passed()) {
-            back.mark(uploads.bytesPerSlice);
-            uploads.run(uploaders);
-          }
-          await nextFrame();
-          if (finished) return;
-        }
-      } else {
-        back.mark(Infinity);  // uploaded when first drawn
-      }
-      swap(model);
+      if (!(await view.show(model, stopped))) return;
       stats.refinements += 1;
       stats.complete = model.complete;
       stats.model = model;
-      options.onRefine?.(group, stats);
+      options.onRefine?.(view.object, stats);
       if (stats.complete) finish();
       else worker.postMessage({ type: 'next' });
     };
-    worker.onmessage = ({ data }) => {
+    const onMessage = ({ data }) => {
       if (finished) return;
       if (data.type === 'header') {
         stats.header = data.header;
         stats.bytesExpected = data.header.totalBytes;
+        view.header?.(data.header);
         options.onHeader?.(data.header);
       } else if (data.type === 'snapshot') {
         drawing = draw(data.model);
       } else if (data.type === 'error') {
-        const error = new Error(data.message);
-        error.code = data.code;
+        const error = Object.assign(new KdmeshError(data.code, data.message), { fromWorker: true });
         drawing.then(() => finish(error));
       }
     };
-    worker.onerror = (event) => finish(new Error(event.message || 'the kdmesh worker failed'));
-    worker.postMessage({ type: 'start', wasmSource: this.wasmSource, tetrahedra: options.tetrahedra, geomorph: options.geomorph });
 
-    group.userData = {
-      stats,
-      loaded,
-      feed: (bytes) => {
-        if (finished) return;
-        stats.bytesReceived += bytes.length;
-        worker.postMessage({ type: 'bytes', bytes }, [bytes.buffer]);
-        options.onProgress?.(stats);
-      },
-      end: () => !finished && worker.postMessage({ type: 'end' }),
-      // A failed or aborted download keeps the current level on screen.
-      fail: (error) => finish(error),
+    // The download starts at once; its first bytes wait in `early` while
+    // the WebAssembly compiles and a worker starts or frees up.
+    const early = [];
+    const feed = (piece) => {
+      if (finished) return;
+      stats.bytesReceived += piece.length;
+      if (worker) worker.postMessage({ type: 'bytes', bytes: piece }, [piece.buffer]);
+      else early.push(piece);
+      progress(progressEvent());
     };
-    options.signal?.addEventListener('abort', () => finish(Object.assign(new Error('aborted'), { code: 'aborted' })));
-    return group;
-  }
-
-  /** Stops every decoding worker and frees the materials. */
-  dispose() {
-    this.uploads?.dispose();
-    for (const worker of this.workers) worker.terminate();
-    this.workers.clear();
-    for (const material of Object.values(this.materials)) material.dispose();
+    const startWorker = async () => {
+      const [acquired, wasm] = await Promise.all([this.#acquire(), this.#compiledWasm()]);
+      if (finished) return this.#release(acquired, true);
+      acquired.onmessage = onMessage;
+      acquired.onerror = (event) => finish(new KdmeshError('worker-failed', `the kdmesh worker failed: ${event.message || 'no message'}`));
+      const limits = options.limits ?? this.decoderLimits;
+      acquired.postMessage({ type: 'start', wasm, limits, tetrahedra: options.tetrahedra, geomorph: options.geomorph });
+      for (const piece of early) acquired.postMessage({ type: 'bytes', bytes: piece }, [piece.buffer]);
+      early.length = 0;
+      worker = acquired;
+    };
+    const stream = async () => {
+      const started = startWorker();
+      started.catch(finish);  // e.g. wasm-unavailable: fails the load without waiting for the download
+      if (bytes) {
+        feed(bytes);
+      } else {
+        const response = await fetch(new Request(resolved, {
+          headers: new Headers(this.requestHeader), credentials: this.withCredentials ? 'include' : 'same-origin', signal: download.signal,
+        }));
+        if (!response.ok) throw new KdmeshError('network', `${resolved}: HTTP ${response.status}`);
+        // The stream's own size comes with its header; until then, the
+        // response's length where the server gives it.
+        stats.bytesExpected = Number(response.headers.get('content-length')) || 0;
+        const reader = response.body.getReader();
+        for (;;) {
+          const { done, value } = await reader.read();
+          if (done) break;
+          feed(value);
+        }
+      }
+      await started;
+      if (!finished) worker.postMessage({ type: 'end' });
+    };
+    stream().catch((error) => finish(error instanceof KdmeshError || finished ? error
+      : new KdmeshError('network', `${resolved}: ${error.message ?? error}`)));
   }
 }

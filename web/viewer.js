@@ -8,13 +8,17 @@ import { modelChecksum } from './model-checksum.js';
 
 const $ = (id) => document.getElementById(id);
 const viewer = (window.kdmeshViewer = {
-  state: 'idle', refinements: 0, vertexCount: 0, triangleCount: 0, tetrahedronCount: 0, edgeCount: 0,
+  // state: 'idle', 'encoding' (a dropped mesh file, on the server),
+  // 'loading', 'complete' or 'error' (also when stopped).
+  state: 'idle', source: null, refinements: 0, vertexCount: 0, triangleCount: 0, tetrahedronCount: 0, edgeCount: 0,
   pointCount: 0, bytesReceived: 0, bytesExpected: 0, level: 0, error: null, firstRenderMs: null,
+  // The complete model's totals, from the stream's header.
+  levelCount: 0, vertexTotal: 0,
   // Since the load began: the first and the last level drawn, and the last
   // level decoded.
   completeMs: null, finalRenderMs: null, levelsSeen: [], longTasks: [],
-  // Decoding workers still running (0 once a load has ended, however).
-  activeWorkers: () => loader.workers.size,
+  // Workers decoding a stream (0 once a load has ended, however).
+  activeWorkers: () => loader.busyWorkers,
   // Of the complete model, for tests to compare with a Node decode. Computed
   // when read: hashing the dragon's arrays takes ~60 ms, a long task the
   // page itself has no use for.
@@ -29,6 +33,20 @@ const viewer = (window.kdmeshViewer = {
     if (!model || !drawn) return false;
     for (let i = 0; i < model.positions.length; ++i) if (drawn[i] !== model.positions[i]) return false;
     return true;
+  },
+  // Of the pixels of a new frame that differ from the background, the share
+  // of the commonest colour (for tests: near 1 for a flat silhouette).
+  commonestColourShare() {
+    const data = framePixels();
+    const counts = new Map();
+    let total = 0;
+    for (let i = 0; i < data.length; i += 4) {
+      if (Math.abs(data[i] - 0xf4) + Math.abs(data[i + 1] - 0xf6) + Math.abs(data[i + 2] - 0xf8) <= 24) continue;
+      const colour = (data[i] << 16) | (data[i + 1] << 8) | data[i + 2];
+      counts.set(colour, (counts.get(colour) ?? 0) + 1);
+      ++total;
+    }
+    return total ? Math.max(...counts.values()) / total : 0;
   },
   // Pixels of a new frame that differ from the background (for tests).
   modelPixels() {
@@ -116,6 +134,7 @@ function requestRender() {
     frameRequested = false;
     paintStatus();
     controls.update();
+    fitFog();
     renderer.render(scene, camera);
     previousFrame.set();
     const elapsed = performance.now() - loadBegan;
@@ -130,11 +149,27 @@ const loader = new KDMeshLoader();
 let current = null;
 let controller = null;
 let framed = false;
+let reloadCurrent = null;  // loads the current model again (after a toggle)
+const files = new Map();   // opened files by menu value: { name, bytes } (.kdm bytes)
+
+// Points have no normals to light them: fog from the front of the model to
+// its back shades them by depth, where a flat colour would show only a
+// silhouette. Surfaces and lines are lit and keep their colours.
+loader.materials.surface.fog = false;
+loader.materials.lines.fog = false;
+scene.fog = new THREE.Fog(scene.background, 1, 2);
+let modelRadius = 0;
+function fitFog() {
+  const distance = camera.position.distanceTo(controls.target);
+  scene.fog.near = Math.max(0, distance - modelRadius);
+  scene.fog.far = distance + 3 * modelRadius;
+}
 
 function frame(group) {
   const box = new THREE.Box3().setFromObject(group);
   if (box.isEmpty()) return;
   const sphere = box.getBoundingSphere(new THREE.Sphere());
+  modelRadius = sphere.radius;
   const distance = (sphere.radius || 1) / Math.sin(THREE.MathUtils.degToRad(camera.fov / 2));
   camera.near = distance / 100;
   camera.far = distance * 100;
@@ -154,28 +189,35 @@ function showStatus(text, isError = false) {
 // main thread wait for it in the compositor's commit (one 95 ms task in
 // nine streamed loads of the dragon, headless chromium with SwiftShader).
 let pendingStatus = null;
-let pendingProgress = null;
+let pendingProgress = null;  // { downloaded, decoded } fractions
 function queueStatus(text, progress) {
   if (text !== undefined) pendingStatus = text;
-  if (progress !== undefined) pendingProgress = progress;
+  if (progress !== undefined) pendingProgress = { ...pendingProgress, ...progress };
   requestRender();
 }
 function paintStatus() {
   if (pendingStatus !== null) showStatus(pendingStatus);
-  if (pendingProgress !== null) $('progress').value = pendingProgress;
+  if (pendingProgress?.downloaded !== undefined) $('progress').value = pendingProgress.downloaded;
+  if (pendingProgress?.decoded !== undefined) $('decoded').value = pendingProgress.decoded;
   pendingStatus = pendingProgress = null;
 }
 
 function describe(stats) {
   const m = stats.model;
+  const count = (n) => n.toLocaleString('en-US');
+  const of = (total) => (total ? ` of ${count(total)}` : '');
   const kb = (viewer.bytesReceived / 1024).toFixed(0);
   const total = viewer.bytesExpected ? ` of ${(viewer.bytesExpected / 1024).toFixed(0)}` : '';
   const bpv = m && m.vertexCount ? ((8 * m.progress.bytesConsumed) / m.vertexCount).toFixed(1) : '–';
-  return `${kb}${total} KiB · level ${viewer.level} · ${viewer.vertexCount} vertices · ${viewer.triangleCount} triangles` +
-    (viewer.tetrahedronCount ? ` · ${viewer.tetrahedronCount} tetrahedra` : '') +
-    (viewer.edgeCount ? ` · ${viewer.edgeCount} edges` : '') + ` · ${bpv} bits/vertex so far`;
+  return `${kb}${total} KiB · level ${viewer.level}${of(viewer.levelCount)} · ${count(viewer.vertexCount)}${of(viewer.vertexTotal)} vertices` +
+    (viewer.triangleCount ? ` · ${count(viewer.triangleCount)} triangles` : '') +
+    (viewer.tetrahedronCount ? ` · ${count(viewer.tetrahedronCount)} tetrahedra` : '') +
+    (viewer.edgeCount ? ` · ${count(viewer.edgeCount)} edges` : '') +
+    ` · ${bpv} bits/vertex${m?.complete ? '' : ' so far'}`;
 }
 
+// Starts a load; `load(options)` returns the model's group. Callbacks of a
+// load that another has replaced change nothing.
 function start(load) {
   controller?.abort();
   if (current) {
@@ -185,20 +227,32 @@ function start(load) {
   controller = new AbortController();
   framed = false;
   const began = (loadBegan = performance.now());
-  Object.assign(viewer, { state: 'loading', refinements: 0, error: null, firstRenderMs: null, completeMs: null, finalRenderMs: null, bytesReceived: 0, levelsSeen: [], longTasks: [] });
+  Object.assign(viewer, {
+    state: 'loading', refinements: 0, error: null, firstRenderMs: null, completeMs: null, finalRenderMs: null, bytesReceived: 0,
+    bytesExpected: 0, levelCount: 0, vertexTotal: 0, levelsSeen: [], longTasks: [],
+  });
   pendingStatus = pendingProgress = null;
+  $('progress').value = $('decoded').value = 0;
   showStatus('loading…');
+  let group = null;
+  const isCurrent = () => group === current;
   const options = {
     signal: controller.signal,
     geomorph: $('geomorph').checked,
     tetrahedra: $('wireframe').checked ? 'wireframe' : 'boundary',
     onAnimate: requestRender,
-    onHeader(header) { viewer.bytesExpected = header.totalBytes; },
-    onProgress(stats) {
-      viewer.bytesReceived = stats.bytesReceived;
-      queueStatus(undefined, stats.bytesExpected ? stats.bytesReceived / stats.bytesExpected : 0);
+    onHeader(header) {
+      if (!isCurrent()) return;
+      Object.assign(viewer, { levelCount: header.depth, vertexTotal: header.vertexCount });
     },
-    onRefine(group, stats) {
+    onProgress(stats) {
+      if (!isCurrent()) return;
+      // The stream's size from its header, before it the response's Content-Length.
+      Object.assign(viewer, { bytesReceived: stats.bytesReceived, bytesExpected: stats.bytesExpected });
+      queueStatus(undefined, { downloaded: stats.bytesExpected ? stats.bytesReceived / stats.bytesExpected : 0 });
+    },
+    onRefine(model, stats) {
+      if (!isCurrent()) return;
       const m = stats.model;
       Object.assign(viewer, {
         refinements: stats.refinements, vertexCount: m.vertexCount, triangleCount: m.triangles.length / 3,
@@ -206,17 +260,21 @@ function start(load) {
         level: m.progress.level,
       });
       if (!viewer.levelsSeen.includes(m.progress.level)) viewer.levelsSeen.push(m.progress.level);
-      if (!framed) { frame(group); framed = true; }
+      if (!framed) { frame(model); framed = true; }
       if (m.complete) {
         viewer.completeMs = performance.now() - began;
         viewer.state = 'complete';
       }
-      queueStatus(describe(stats), m.complete ? 1 : undefined);
+      queueStatus(describe(stats), {
+        decoded: viewer.vertexTotal ? m.vertexCount / viewer.vertexTotal : 0,
+        ...(m.complete ? { downloaded: 1 } : {}),
+      });
     },
   };
-  current = load(options);
+  group = current = load(options);
   scene.add(current);
   current.userData.loaded.catch((error) => {
+    if (!isCurrent()) return;
     pendingStatus = null;
     viewer.state = 'error';
     viewer.error = error.code === 'aborted' ? 'stopped: showing the last level received' : error.message;
@@ -224,28 +282,65 @@ function start(load) {
   });
 }
 
-function loadUrl(url, throttle) {
+// A gallery model (by menu value) or a URL, paced by the throttle menu.
+function loadUrl(url) {
+  const throttle = Number($('throttle').value);
   const full = throttle > 0 ? `${url}${url.includes('?') ? '&' : '?'}throttle=${throttle}` : url;
+  viewer.source = url;
+  reloadCurrent = () => loadUrl(url);
   start((options) => loader.loadProgressive(full, options));
 }
 
-async function loadFile(file) {
+// A file already in the menu (see openFile).
+function loadFile(value) {
+  const { name, bytes } = files.get(value);
+  viewer.source = name;
+  reloadCurrent = () => loadFile(value);
+  const url = URL.createObjectURL(new Blob([bytes]));
+  start((options) => {
+    const group = loader.loadProgressive(url, options);
+    group.userData.loaded.finally(() => URL.revokeObjectURL(url)).catch(() => {});
+    return group;
+  });
+}
+
+// What the server's encoder said, for the status line: its first line.
+const firstLine = (text) => text.trim().split('\n')[0].slice(0, 300);
+
+// Opens a dropped or picked file: a .kdm as it is, a mesh file encoded by
+// the dev server first. The menu then shows it.
+async function openFile(file) {
+  controller?.abort();
   let bytes = new Uint8Array(await file.arrayBuffer());
   if (!file.name.toLowerCase().endsWith('.kdm')) {
+    Object.assign(viewer, { state: 'encoding', error: null, source: file.name });
     showStatus(`encoding ${file.name} on the server…`);
-    const response = await fetch(`encode?name=${encodeURIComponent(file.name)}`, { method: 'POST', body: bytes });
+    let response;
+    try {
+      response = await fetch(`encode?name=${encodeURIComponent(file.name)}`, { method: 'POST', body: bytes });
+    } catch (error) {
+      response = { ok: false, text: async () => error.message };
+    }
     if (!response.ok) {
       viewer.state = 'error';
-      viewer.error = `cannot encode ${file.name}: ${await response.text()}`;
+      viewer.error = `cannot encode ${file.name}: ${firstLine(await response.text())}`;
       showStatus(viewer.error, true);
       return;
     }
     bytes = new Uint8Array(await response.arrayBuffer());
   }
-  start((options) => {
-    const group = loader.loadProgressive(URL.createObjectURL(new Blob([bytes])), options);
-    return group;
-  });
+  const value = `file:${file.name}`;
+  if (!files.has(value)) $('model').add(new Option(`${file.name} (file)`, value));
+  files.set(value, { name: file.name, bytes });
+  $('model').value = value;
+  loadFile(value);
+}
+
+// Loads what the model menu shows.
+function loadSelected() {
+  const value = $('model').value;
+  if (files.has(value)) loadFile(value);
+  else if (value) loadUrl(/^(https?:|\/|\.)/.test(value) ? value : `models/${encodeURIComponent(value)}`);
 }
 
 async function gallery() {
@@ -257,7 +352,9 @@ async function gallery() {
   }
 }
 
-// Shaders compile before the first model streams, not while it does.
+// The decoder compiles and a worker starts, and shaders compile, before the
+// first model streams, not while it does.
+loader.preload();
 await loader.prepareRenderer(renderer, camera, scene);
 const params = new URLSearchParams(location.search);
 $('geomorph').checked = params.get('geomorph') === '1';
@@ -267,26 +364,27 @@ if (![...$('throttle').options].some((o) => o.value === String(throttle)))
 $('throttle').value = String(throttle);
 const models = await gallery();
 for (const { name, bytes } of models) $('model').add(new Option(`${name} (${(bytes / 1024).toFixed(0)} KiB)`, name));
-const requested = params.get('model') ?? models[0]?.name;
+// A gallery model by its file name, or by its name without .kdm; else a URL.
+const asked = params.get('model');
+const requested = models.find((m) => m.name === asked || m.name === `${asked}.kdm`)?.name ?? asked ?? models[0]?.name;
 if (requested && !models.some((m) => m.name === requested)) $('model').add(new Option(requested, requested));
 if (requested) {
   $('model').value = requested;
-  loadUrl(/^(https?:|\/|\.)/.test(requested) ? requested : `models/${encodeURIComponent(requested)}`, throttle);
+  loadSelected();
 }
 
-$('model').addEventListener('change', () => loadUrl(`models/${encodeURIComponent($('model').value)}`, Number($('throttle').value)));
-$('throttle').addEventListener('change', () => $('model').value && loadUrl(`models/${encodeURIComponent($('model').value)}`, Number($('throttle').value)));
+$('model').addEventListener('change', loadSelected);
+$('throttle').addEventListener('change', () => reloadCurrent?.());
 $('stop').addEventListener('click', () => controller?.abort());
-const reload = () => $('model').value && loadUrl(`models/${encodeURIComponent($('model').value)}`, Number($('throttle').value));
-$('geomorph').addEventListener('change', reload);
-$('wireframe').addEventListener('change', reload);
+$('geomorph').addEventListener('change', () => reloadCurrent?.());
+$('wireframe').addEventListener('change', () => reloadCurrent?.());
 
-$('file').addEventListener('change', () => $('file').files[0] && loadFile($('file').files[0]));
+$('file').addEventListener('change', () => $('file').files[0] && openFile($('file').files[0]));
 const view = $('view');
 view.addEventListener('dragover', (e) => { e.preventDefault(); view.classList.add('dragging'); });
 view.addEventListener('dragleave', () => view.classList.remove('dragging'));
 view.addEventListener('drop', (e) => {
   e.preventDefault();
   view.classList.remove('dragging');
-  if (e.dataTransfer.files[0]) loadFile(e.dataTransfer.files[0]);
+  if (e.dataTransfer.files[0]) openFile(e.dataTransfer.files[0]);
 });

@@ -22,6 +22,11 @@ before(async () => {
   const corrupt = Uint8Array.from(bytes);
   corrupt[bytes.length >> 1] ^= 0x5a;
   writeFileSync(join(models, 'corrupt.kdm'), corrupt);
+  // A 20 KB point cloud in chunks of at most 2 KiB (11 chunks, each a
+  // possible refinement; the default 16 KiB would make 5, and the page draws
+  // at most one level per frame), and one in the default chunks.
+  execFileSync(cli, ['encode', join(root, 'build', 'models', 'fandisk.off'), '-o', join(models, 'small.kdm'), '--bits', '14', '--points-only', '--chunk-bytes', '2048', '-q']);
+  execFileSync(cli, ['encode', join(root, 'build', 'models', 'fandisk.off'), '-o', join(models, 'points.kdm'), '--bits', '12', '--points-only', '-q']);
   execFileSync('mkdir', ['-p', screenshots]);
   server = await startServer({ port: 0, root: models, host: '127.0.0.1' });
   base = `http://127.0.0.1:${server.address().port}`;
@@ -37,8 +42,8 @@ after(async () => {
   server?.close();
 });
 
-async function openViewer(query) {
-  const page = await browser.newPage({ viewport: { width: 800, height: 600 } });
+async function openViewer(query, viewport = { width: 800, height: 600 }) {
+  const page = await browser.newPage({ viewport });
   const errors = [];
   page.on('pageerror', (error) => errors.push(error.message));
   await page.goto(`${base}/?${query}`, { waitUntil: 'domcontentloaded' });
@@ -112,6 +117,92 @@ test('geomorphs animate refinements and end exactly on the model', async () => {
   await page.waitForFunction(() => window.kdmeshViewer.drawnPositionsMatch(), null, { timeout: 10000 });
   const state = await viewerState(page);
   assert.ok(state.refinements >= 3, `refinements: ${state.refinements}`);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('a 20 KB point cloud at 400 kbit/s refines at least 5 times; ?model= takes a name without .kdm; the status ends with totals', async () => {
+  const { page, errors } = await openViewer('model=small&throttle=400');
+  await page.waitForFunction(() => ['complete', 'error'].includes(window.kdmeshViewer.state), null, { timeout: 60000 });
+  const state = await viewerState(page);
+  assert.equal(state.state, 'complete', state.error ?? '');
+  assert.equal(state.source, 'models/small.kdm');
+  assert.ok(state.bytesExpected > 19000 && state.bytesExpected < 22000, `bytes: ${state.bytesExpected}`);
+  assert.ok(state.refinements >= 5, `refinements: ${state.refinements}`);
+  assert.ok(state.levelsSeen.length >= 5, `levels: ${state.levelsSeen}`);
+  assert.equal(state.level, state.levelCount);
+  assert.equal(state.vertexCount, state.vertexTotal);
+  const status = await page.textContent('#status');
+  assert.match(status, new RegExp(`level ${state.levelCount} of ${state.levelCount} · ([\\d,]+) of \\1 vertices`), status);
+  assert.doesNotMatch(status, /so far/);
+  assert.deepEqual(await page.evaluate(() => [document.getElementById('progress').value, document.getElementById('decoded').value]), [1, 1]);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('switching models mid-load: the new model loads and completes, the old one is stopped quietly', async () => {
+  const { page, errors } = await openViewer('model=dragon.kdm&throttle=400');
+  await page.waitForFunction(() => window.kdmeshViewer.refinements >= 1, null, { timeout: 60000 });
+  const loading = await page.evaluate(() => window.kdmeshViewer.state);
+  await page.selectOption('#model', 'small.kdm');
+  await page.waitForFunction(() => ['complete', 'error'].includes(window.kdmeshViewer.state), null, { timeout: 60000 });
+  // Long enough for the dragon's rejection to have arrived.
+  await page.waitForTimeout(500);
+  const state = await viewerState(page);
+  assert.equal(loading, 'loading');
+  assert.equal(state.state, 'complete', state.error ?? '');
+  assert.equal(state.error, null);
+  assert.equal(state.source, 'models/small.kdm');
+  assert.equal(await page.evaluate(() => window.kdmeshViewer.activeWorkers()), 0);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('an opened mesh file: encoding state, the menu shows it, toggles reload it; a bad file gives a clean message', async () => {
+  const { page, errors } = await openViewer('model=points.kdm');
+  await page.waitForFunction(() => window.kdmeshViewer.state === 'complete', null, { timeout: 60000 });
+  // Slow the encoder down so that its state can be seen.
+  await page.route('**/encode?*', async (route) => {
+    await new Promise((resolve) => setTimeout(resolve, 700));
+    await route.continue();
+  });
+  const obj = readFileSync(join(root, 'build', 'models', 'triceratops.off'), 'utf8');
+  await page.setInputFiles('#file', { name: 'triceratops.off', mimeType: 'application/octet-stream', buffer: Buffer.from(obj) });
+  await page.waitForFunction(() => window.kdmeshViewer.state === 'encoding', null, { timeout: 10000 });
+  assert.match(await page.textContent('#status'), /encoding triceratops\.off/);
+  await page.waitForFunction(() => window.kdmeshViewer.state === 'complete', null, { timeout: 60000 });
+  const opened = await viewerState(page);
+  assert.equal(opened.source, 'triceratops.off');
+  assert.equal(opened.triangleCount, 5660);
+  assert.equal(await page.$eval('#model', (select) => select.selectedOptions[0].textContent), 'triceratops.off (file)');
+  // A toggle reloads the file, not the gallery model.
+  await page.click('#geomorph');
+  await page.waitForFunction(() => window.kdmeshViewer.state === 'loading' || window.kdmeshViewer.refinements === 0, null, { timeout: 10000 });
+  await page.waitForFunction(() => window.kdmeshViewer.state === 'complete', null, { timeout: 60000 });
+  const toggled = await viewerState(page);
+  assert.equal(toggled.source, 'triceratops.off');
+  assert.equal(toggled.triangleCount, 5660);
+
+  const garbage = Buffer.from([0x70, 0x6c, 0x79, 0x0a, 0xff, 0xfe, 0x00, 0x01, 0x9c, 0x0a]);
+  await page.setInputFiles('#file', { name: 'broken.ply', mimeType: 'application/octet-stream', buffer: garbage });
+  await page.waitForFunction(() => window.kdmeshViewer.state === 'error', null, { timeout: 20000 });
+  const status = await page.textContent('#status');
+  assert.match(status, /^cannot encode broken\.ply: broken\.ply: /);
+  assert.doesNotMatch(status, /\/tmp|kdmesh-encode|input\.ply|kdmesh: error/);
+  assert.doesNotMatch(status, /[\x00-\x1f\x7f-\x9f\ufffd]/);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('the header stays on one line at 1000 px, and the point cloud is shaded, not a flat silhouette', async () => {
+  const { page, errors } = await openViewer('model=points', { width: 1000, height: 700 });
+  await page.waitForFunction(() => window.kdmeshViewer.state === 'complete', null, { timeout: 60000 });
+  const tops = await page.$$eval('header > *', (children) => children.map((child) => Math.round(child.getBoundingClientRect().top)));
+  assert.ok(Math.max(...tops) - Math.min(...tops) <= 6, `tops of the header's items: ${tops}`);
+  assert.equal(await page.$eval('#file', (input) => input.accept.split(',').includes('.xyz')), true);
+  const share = await page.evaluate(() => window.kdmeshViewer.commonestColourShare());
+  await page.screenshot({ path: join(screenshots, 'points.png') });
+  assert.ok(share > 0 && share < 0.2, `share of the commonest colour: ${share}`);
   assert.deepEqual(errors, []);
   await page.close();
 });

@@ -1,0 +1,280 @@
+// KDMeshLoader in headless chromium, as a three.js application uses it:
+// LoadingManager events and URL handling, abort(), dispose() mid-load, the
+// worker pool's limit, the BufferGeometry result, decoder limits and a
+// WebAssembly file that cannot be fetched. Models come from the viewer's
+// dev server, paced where a load must still be running.
+import { test, before, after } from 'node:test';
+import assert from 'node:assert/strict';
+import { execFileSync } from 'node:child_process';
+import { mkdtempSync, readFileSync } from 'node:fs';
+import { tmpdir } from 'node:os';
+import { join } from 'node:path';
+import { chromium } from 'playwright-core';
+import { decode } from 'kdmesh';
+import { startServer } from '../../web/server.mjs';
+import { modelChecksum } from '../../web/model-checksum.js';
+import { root, cli } from '../js/fixtures.mjs';
+
+const models = mkdtempSync(join(tmpdir(), 'kdmesh-loader-'));
+let server, browser, base, expected;
+
+// A page with three.js and kdmesh/three in its import map, as the viewer has.
+const testPage = `<!doctype html><meta charset="utf-8"><link rel="icon" href="data:,">
+<script type="importmap">{ "imports": { "three": "./vendor/three/build/three.module.js", "kdmesh": "./kdmesh.js", "kdmesh/three": "./three.js" } }</script>
+<script type="module">
+  import * as THREE from 'three';
+  import { KDMeshLoader } from 'kdmesh/three';
+  import { modelChecksum } from './model-checksum.js';
+  Object.assign(window, { THREE, KDMeshLoader, modelChecksum, ready: true });
+</script>`;
+
+before(async () => {
+  execFileSync(cli, ['encode', join(root, 'build', 'models', 'fandisk.off'), '-o', join(models, 'fandisk.kdm'), '--bits', '12', '-q']);
+  const decoded = await decode(readFileSync(join(models, 'fandisk.kdm')));
+  expected = { checksum: modelChecksum(decoded), vertexCount: decoded.vertexCount, indices: decoded.triangles.length, bytes: readFileSync(join(models, 'fandisk.kdm')).length };
+  server = await startServer({ port: 0, root: models, host: '127.0.0.1' });
+  base = `http://127.0.0.1:${server.address().port}`;
+  browser = await chromium.launch({
+    executablePath: '/usr/bin/chromium',
+    headless: true,
+    args: ['--no-sandbox', '--disable-background-networking', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
+  });
+});
+
+after(async () => {
+  await browser?.close();
+  server?.close();
+});
+
+async function openPage() {
+  const page = await browser.newPage();
+  const errors = [];
+  page.on('pageerror', (error) => errors.push(error.message));
+  await page.route(`${base}/loader-test.html`, (route) => route.fulfill({ body: testPage, contentType: 'text/html' }));
+  await page.goto(`${base}/loader-test.html`);
+  await page.waitForFunction(() => window.ready);
+  return { page, errors };
+}
+
+test('LoadingManager: itemStart, progress, itemError and itemEnd, resolveURL, path and request headers', async () => {
+  const { page, errors } = await openPage();
+  const headers = [];
+  page.on('request', (request) => request.url().includes('/models/') && headers.push(request.headers()['x-kdmesh-test']));
+  const result = await page.evaluate(async () => {
+    const events = [];
+    const manager = new THREE.LoadingManager(() => events.push('load'), (url, loaded, total) => events.push(`progress ${url.split('/').pop()} ${loaded}/${total}`),
+      (url) => events.push(`error ${url.split('/').pop()}`));
+    manager.onStart = (url) => events.push(`start ${url.split('/').pop()}`);
+    manager.setURLModifier((url) => url.replace('renamed.kdm', 'fandisk.kdm'));
+    const loader = new KDMeshLoader(manager).setPath('models/').setRequestHeader({ 'X-Kdmesh-Test': 'yes' });
+    const progress = [];
+    const group = await loader.loadAsync('renamed.kdm', (event) => progress.push([event.loaded, event.total]));
+    const missing = await loader.loadAsync('missing.kdm').then(() => 'loaded', (error) => error.code);
+    loader.dispose();
+    return { events, progress, missing, checksum: modelChecksum(group.userData.stats.model) };
+  });
+  assert.equal(result.checksum, expected.checksum);
+  assert.equal(result.missing, 'network');
+  assert.deepEqual(result.events, [
+    'start fandisk.kdm', 'progress fandisk.kdm 1/1', 'load',  // the URL as resolved
+    'start missing.kdm', 'error missing.kdm', 'progress missing.kdm 2/2', 'load',
+  ]);
+  // The first event comes before the stream's header: its total is the response's Content-Length.
+  assert.equal(result.progress[0][1], expected.bytes);
+  assert.deepEqual(result.progress.at(-1), [expected.bytes, expected.bytes]);
+  assert.deepEqual(headers, ['yes', 'yes']);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('abort() stops every load in flight, keeps its level and frees the workers', async () => {
+  const { page, errors } = await openPage();
+  const result = await page.evaluate(async () => {
+    const loader = new KDMeshLoader();
+    const models = [1, 2].map(() => loader.loadProgressive('models/fandisk.kdm?throttle=20'));
+    await new Promise((resolve) => {
+      const check = () => (models.every((m) => m.userData.stats.refinements >= 1) ? resolve() : setTimeout(check, 20));
+      check();
+    });
+    const returned = loader.abort() === loader;
+    const outcomes = await Promise.all(models.map((m) => m.userData.loaded.then(() => 'loaded', (error) => error.code)));
+    return {
+      returned, outcomes, busy: loader.busyWorkers,
+      vertices: models.map((m) => m.userData.stats.model.vertexCount),
+      visible: models.map((m) => m.children[0].visible),
+    };
+  });
+  assert.equal(result.returned, true);
+  assert.deepEqual(result.outcomes, ['aborted', 'aborted']);
+  assert.equal(result.busy, 0);
+  for (const count of result.vertices) assert.ok(count > 0 && count < expected.vertexCount, `vertices: ${count}`);
+  assert.deepEqual(result.visible, [true, true]);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('dispose() mid-load settles every load, ends every worker and returns the loader', async () => {
+  const { page, errors } = await openPage();
+  const result = await page.evaluate(async () => {
+    const loader = new KDMeshLoader().setWorkerLimit(1);
+    const streaming = loader.loadProgressive('models/fandisk.kdm?throttle=20');
+    const queued = loader.loadGeometry('models/fandisk.kdm');  // waits for the only worker
+    await new Promise((resolve) => {
+      const check = () => (streaming.userData.stats.bytesReceived > 0 ? resolve() : setTimeout(check, 20));
+      check();
+    });
+    const returned = loader.dispose() === loader;
+    const outcomes = await Promise.all([streaming, queued].map((m) => m.userData.loaded.then(() => 'loaded', (error) => error.code)));
+    return { returned, outcomes, workers: loader.workers.size };
+  });
+  assert.equal(result.returned, true);
+  assert.deepEqual(result.outcomes, ['disposed', 'disposed']);
+  assert.equal(result.workers, 0);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('setWorkerLimit caps the workers; queued loads wait, then every load completes exactly', async () => {
+  const { page, errors } = await openPage();
+  const result = await page.evaluate(async () => {
+    const runs = {};
+    for (const limit of [1, 2]) {
+      const loader = new KDMeshLoader().setWorkerLimit(limit);
+      let most = 0;
+      const models = [1, 2, 3].map(() => loader.loadProgressive('models/fandisk.kdm?throttle=400', {
+        onProgress: () => (most = Math.max(most, loader.workers.size)),
+      }));
+      const groups = await Promise.all(models.map((m) => m.userData.loaded));
+      runs[limit] = { most, workers: loader.workers.size, busy: loader.busyWorkers, checksums: groups.map((g) => modelChecksum(g.userData.stats.model)) };
+      loader.dispose();
+    }
+    return runs;
+  });
+  for (const limit of [1, 2]) {
+    const run = result[limit];
+    assert.equal(run.most, limit, `limit ${limit}`);
+    assert.equal(run.workers, limit, 'finished workers stay for the next loads');
+    assert.equal(run.busy, 0);
+    assert.deepEqual(run.checksums, [expected.checksum, expected.checksum, expected.checksum]);
+  }
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('loadGeometry refines one BufferGeometry in place and ends on the model', async () => {
+  const { page, errors } = await openPage();
+  const result = await page.evaluate(async () => {
+    const loader = new KDMeshLoader();
+    const seen = [];
+    const geometry = loader.loadGeometry('models/fandisk.kdm?throttle=100', {
+      onRefine: (g, stats) => seen.push({ same: g === geometry, count: g.drawRange.count, vertices: stats.model.vertexCount }),
+    });
+    const mesh = new THREE.Mesh(geometry, new THREE.MeshNormalMaterial());
+    const resolved = await geometry.userData.loaded;
+    const position = geometry.getAttribute('position');
+    const model = geometry.userData.stats.model;
+    const drawn = Array.from(position.array.subarray(0, 3 * model.vertexCount));
+    loader.dispose();
+    return {
+      seen, sameResolved: resolved === geometry, primitive: geometry.userData.primitive, isMeshGeometry: mesh.geometry === geometry,
+      indexCount: geometry.drawRange.count, positionsMatch: drawn.every((v, i) => v === model.positions[i]),
+      normals: geometry.getAttribute('normal')?.count, radius: geometry.boundingSphere.radius, checksum: modelChecksum(model),
+    };
+  });
+  assert.ok(result.seen.length >= 3, `refinements: ${result.seen.length}`);
+  assert.ok(result.seen.every((s) => s.same));
+  for (let i = 1; i < result.seen.length; ++i) assert.ok(result.seen[i].vertices >= result.seen[i - 1].vertices, JSON.stringify(result.seen));
+  assert.ok(result.seen[0].vertices < expected.vertexCount && result.seen[0].count < expected.indices, JSON.stringify(result.seen[0]));
+  assert.equal(result.sameResolved, true);
+  assert.equal(result.primitive, 'triangles');
+  assert.equal(result.indexCount, expected.indices);
+  assert.equal(result.positionsMatch, true);
+  assert.equal(result.normals, expected.vertexCount);
+  assert.ok(result.radius > 0);
+  assert.equal(result.checksum, expected.checksum);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('decoder limits reach the worker, and an unreachable wasm rejects with wasm-unavailable', async () => {
+  const { page, errors } = await openPage();
+  const result = await page.evaluate(async () => {
+    const limited = new KDMeshLoader().setDecoderLimits({ maxVertices: 100 });
+    const code = (promise) => promise.then(() => 'loaded', (error) => error.code);
+    const loaderLimit = await code(limited.loadProgressive('models/fandisk.kdm').userData.loaded);
+    const loadLimit = await code(new KDMeshLoader().loadProgressive('models/fandisk.kdm', { limits: { maxSimplices: 100 } }).userData.loaded);
+    const unlimited = await code(limited.loadProgressive('models/fandisk.kdm', { limits: {} }).userData.loaded);
+    const started = performance.now();
+    const noWasm = await code(new KDMeshLoader().setDecoderPath('/nowhere/').loadProgressive('models/fandisk.kdm').userData.loaded);
+    return { loaderLimit, loadLimit, unlimited, noWasm, ms: performance.now() - started };
+  });
+  assert.deepEqual({ ...result, ms: undefined }, {
+    loaderLimit: 'limit-exceeded', loadLimit: 'limit-exceeded', unlimited: 'loaded', noWasm: 'wasm-unavailable', ms: undefined,
+  });
+  assert.ok(result.ms < 5000, `rejected after ${result.ms} ms`);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('parse() decodes bytes in memory, from an ArrayBuffer or a view of one', async () => {
+  const { page, errors } = await openPage();
+  const result = await page.evaluate(async () => {
+    const loader = new KDMeshLoader();
+    const bytes = new Uint8Array(await (await fetch('models/fandisk.kdm')).arrayBuffer());
+    const padded = new Uint8Array(bytes.length + 16);
+    padded.set(bytes, 8);
+    const fromBuffer = await new Promise((resolve, reject) => loader.parse(bytes.buffer, resolve, reject));
+    const fromView = await new Promise((resolve, reject) => loader.parse(padded.subarray(8, 8 + bytes.length), resolve, reject));
+    const truncated = await new Promise((resolve) => loader.parse(bytes.subarray(0, 5000), () => resolve('loaded'), (error) => resolve(error.code)));
+    loader.dispose();
+    return { buffer: modelChecksum(fromBuffer.userData.stats.model), view: modelChecksum(fromView.userData.stats.model), truncated };
+  });
+  assert.deepEqual(result, { buffer: expected.checksum, view: expected.checksum, truncated: 'truncated' });
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('preload() starts a worker that the first load then uses', async () => {
+  const { page, errors } = await openPage();
+  const result = await page.evaluate(async () => {
+    const loader = new KDMeshLoader();
+    const returned = loader.preload() === loader;
+    await new Promise((resolve) => {
+      const check = () => (loader.workers.size === 1 ? resolve() : setTimeout(check, 10));
+      check();
+    });
+    const [worker] = loader.workers;
+    const before = { workers: loader.workers.size, busy: loader.busyWorkers };
+    let during = null;
+    const model = loader.loadProgressive('models/fandisk.kdm', { onRefine: () => (during ??= { busy: loader.busyWorkers }) });
+    await model.userData.loaded;
+    const after = { workers: loader.workers.size, busy: loader.busyWorkers, same: [...loader.workers][0] === worker };
+    loader.dispose();
+    return { returned, before, during, after };
+  });
+  assert.deepEqual(result, {
+    returned: true, before: { workers: 1, busy: 0 }, during: { busy: 1 }, after: { workers: 1, busy: 0, same: true },
+  });
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('an idle worker ends after workerIdleTime', async () => {
+  const { page, errors } = await openPage();
+  const result = await page.evaluate(async () => {
+    const loader = new KDMeshLoader();
+    loader.workerIdleTime = 300;
+    await loader.loadProgressive('models/fandisk.kdm').userData.loaded;
+    const right = loader.workers.size;
+    // Reused within the idle time, the worker is kept.
+    await new Promise((resolve) => setTimeout(resolve, 150));
+    await loader.loadProgressive('models/fandisk.kdm').userData.loaded;
+    await new Promise((resolve) => setTimeout(resolve, 200));
+    const reused = loader.workers.size;
+    await new Promise((resolve) => setTimeout(resolve, 400));
+    return { right, reused, later: loader.workers.size };
+  });
+  assert.deepEqual(result, { right: 1, reused: 1, later: 0 });
+  assert.deepEqual(errors, []);
+  await page.close();
+});

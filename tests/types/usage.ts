@@ -1,0 +1,68 @@
+// Uses every export of kdmesh and kdmesh/three as a TypeScript program
+// would; tests/types/types.test.mjs compiles it with tsc --strict.
+import { compileWasm, createDecoder, decode, Decoder, Header, KdmeshError, memoryInUse, Model, Progress, setWasmSource } from 'kdmesh';
+import { GpuFence, KDMeshLoader, LoadStats } from 'kdmesh/three';
+import { BufferGeometry, Group, LoadingManager, Mesh, MeshNormalMaterial, PerspectiveCamera, Scene, WebGLRenderer } from 'three';
+
+export async function decoding(bytes: Uint8Array): Promise<number> {
+  setWasmSource(new URL('https://example.com/kdmesh-wasm.wasm'));
+  const module: WebAssembly.Module = await compileWasm(bytes);
+  setWasmSource(module);
+  const model: Model = await decode(bytes, { limits: { maxVertices: 1e6 } });
+  const decoder: Decoder = await createDecoder();
+  const progress: Progress = decoder.push(bytes.subarray(0, 100));
+  const header: Header | null = decoder.header;
+  const coarse = decoder.snapshot({ copy: false });
+  const parents: Uint32Array = decoder.parents();
+  decoder.finish();
+  decoder.dispose();
+  try {
+    await decode(new Uint8Array(3));
+  } catch (error) {
+    if (error instanceof KdmeshError) return error.code.length;
+  }
+  return model.positions.length + progress.errorBound + (header?.simplexCounts[2] ?? 0) + coarse.triangles.length +
+    parents.length + (await memoryInUse()) + (model.stats.bitsPerVertex > 0 ? 1 : 0);
+}
+
+export async function loading(renderer: WebGLRenderer): Promise<BufferGeometry> {
+  const manager = new LoadingManager();
+  const loader = new KDMeshLoader(manager)
+    .setWorkerLimit(2)
+    .setDecoderLimits({ maxVertices: 1e7 })
+    .setDecoderPath('/kdmesh/')
+    .setWasmSource(new ArrayBuffer(8))
+    .setWorkerUrl(new URL('https://example.com/kdmesh-worker.js'))
+    .setRequestHeader({ Authorization: 'token' })
+    .setWithCredentials(true)
+    .setPath('/models/')
+    .preload();
+  loader.workerIdleTime = 5000;
+  const scene = new Scene();
+  const camera = new PerspectiveCamera();
+  await loader.prepareRenderer(renderer, camera, scene);
+  const controller = new AbortController();
+  const group: Group = loader.loadProgressive('a.kdm', {
+    signal: controller.signal,
+    geomorph: true,
+    tetrahedra: 'wireframe',
+    limits: { maxSimplices: 1e7 },
+    onRefine: (object: Group, stats: LoadStats) => object.visible === stats.complete,
+    onHeader: (header: Header) => header.totalBytes,
+    onProgress: (stats: LoadStats, event: ProgressEvent) => stats.bytesReceived + event.loaded,
+  });
+  scene.add(group);
+  await group.userData.loaded;
+  const whole: Group = await loader.loadAsync('b.kdm');
+  loader.load('c.kdm', (g: Group) => scene.add(g), (event: ProgressEvent) => event.total, (error: unknown) => String(error));
+  loader.parse(new ArrayBuffer(10), (g: Group) => g.children.length);
+  const geometry = loader.loadGeometry('d.kdm', { onRefine: (g: BufferGeometry) => g.drawRange.count });
+  scene.add(new Mesh(geometry, new MeshNormalMaterial()));
+  const primitive: 'triangles' | 'lines' | 'points' | undefined = geometry.userData.primitive;
+  await geometry.userData.loaded;
+  const fence = new GpuFence(renderer.getContext() as WebGL2RenderingContext);
+  fence.set();
+  const busy: number = loader.busyWorkers + (fence.passed() ? 1 : 0) + (primitive ? 1 : 0) + whole.children.length;
+  loader.materials.surface.color.set(busy);
+  return loader.abort().dispose() === loader ? geometry : new BufferGeometry();
+}

@@ -1,0 +1,95 @@
+// Type declarations for kdmesh/three (web/three.js).
+import {
+  BufferGeometry, Camera, Group, LineBasicMaterial, Loader, LoadingManager, MeshStandardMaterial, PointsMaterial, Scene,
+  WebGLRenderer,
+} from 'three';
+import { DecoderLimits, Header, Model, Progress, WasmSource } from 'kdmesh';
+
+/** A level as the worker hands it over: the Model's lists plus what drawing needs. */
+export interface StreamedModel extends Model {
+  /** Boundary triangles of the tetrahedra, stored right after `triangles`. */
+  boundary: Uint32Array;
+  /** Edges of the tetrahedra ('wireframe'), stored right after `edges`. */
+  tetrahedronEdges: Uint32Array;
+  /** [minX, minY, minZ, maxX, maxY, maxZ] */
+  bounds: number[];
+  normals: Float32Array;
+  /** With geomorph: the vertex each vertex was split from. */
+  parents: Uint32Array;
+  progress: Progress;
+}
+
+export interface LoadStats {
+  refinements: number;
+  bytesReceived: number;
+  /** The stream's size from its header, before it the response's Content-Length (0 if unknown). */
+  bytesExpected: number;
+  header: Header | null;
+  complete: boolean;
+  /** The last level drawn. */
+  model: StreamedModel | null;
+}
+
+export interface LoadOptions<T> {
+  onRefine?: (object: T, stats: LoadStats) => void;
+  onHeader?: (header: Header) => void;
+  onProgress?: (stats: LoadStats, event: ProgressEvent) => void;
+  /** Aborting stops the download and keeps the current level. */
+  signal?: AbortSignal;
+  /** Decoder caps for this load (default: setDecoderLimits'). */
+  limits?: DecoderLimits;
+}
+
+export interface ProgressiveOptions extends LoadOptions<Group> {
+  tetrahedra?: 'boundary' | 'wireframe';
+  geomorph?: boolean;
+  geomorphFrames?: number;
+  onAnimate?: (object: Group) => void;
+}
+
+export interface ModelUserData {
+  stats: LoadStats;
+  /** Resolves with the object once complete; rejects with a KdmeshError. */
+  loaded: Promise<unknown>;
+}
+
+export interface GeometryUserData extends ModelUserData {
+  /** What the index holds, once the header has arrived. */
+  primitive?: 'triangles' | 'lines' | 'points';
+}
+
+/** Tells without waiting whether the GPU has finished the work issued before the last set(). */
+export class GpuFence {
+  constructor(gl: WebGL2RenderingContext);
+  passed(): boolean;
+  set(): void;
+}
+
+export class KDMeshLoader extends Loader<Group> {
+  constructor(manager?: LoadingManager);
+  materials: { surface: MeshStandardMaterial; lines: LineBasicMaterial; points: PointsMaterial };
+  uploadBytesPerSlice: number;
+  workerLimit: number;
+  /** Milliseconds after which an idle worker ends (default 10000). */
+  workerIdleTime: number;
+  decoderLimits: DecoderLimits;
+  /** Every worker started, busy or idle. */
+  readonly workers: Set<Worker>;
+  /** Workers decoding a stream now. */
+  readonly busyWorkers: number;
+
+  prepareRenderer(renderer: WebGLRenderer, camera: Camera, scene: Scene): Promise<void>;
+  setDecoderPath(path: string): this;
+  setWasmSource(source: WasmSource): this;
+  setWorkerUrl(url: string | URL): this;
+  setWorkerLimit(limit: number): this;
+  setDecoderLimits(limits: DecoderLimits): this;
+  preload(): this;
+  load(url: string, onLoad?: (group: Group) => void, onProgress?: (event: ProgressEvent) => void,
+    onError?: (error: unknown) => void): Group;
+  parse(buffer: ArrayBuffer | ArrayBufferView, onLoad?: (group: Group) => void, onError?: (error: unknown) => void): Group;
+  loadProgressive(url: string, options?: ProgressiveOptions): Group & { userData: ModelUserData };
+  loadGeometry(url: string, options?: LoadOptions<BufferGeometry>): BufferGeometry & { userData: GeometryUserData };
+  abort(): this;
+  dispose(): this;
+}
