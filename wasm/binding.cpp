@@ -108,12 +108,15 @@ const std::vector<uint32_t>& indices(const kdmesh::Complex& c, int dimension) {
 
 extern "C" {
 
-EMSCRIPTEN_KEEPALIVE KdmDecoder* kdm_create(uint32_t maxVertices, uint32_t maxSimplices,
-                                            uint32_t maxChunkBytes) {
+// Limits of 0 keep the defaults (kdmesh::DecoderLimits).
+EMSCRIPTEN_KEEPALIVE KdmDecoder* kdm_create(uint32_t maxVertices, uint32_t maxSimplices, uint32_t maxChunkBytes,
+                                            uint32_t maxVerticesPerByte, uint32_t maxSimplicesPerByte) {
   kdmesh::DecoderOptions options;
   if (maxVertices) options.limits.maxVertices = maxVertices;
   if (maxSimplices) options.limits.maxSimplices = maxSimplices;
   if (maxChunkBytes) options.limits.maxChunkBytes = maxChunkBytes;
+  if (maxVerticesPerByte) options.limits.maxVerticesPerByte = maxVerticesPerByte;
+  if (maxSimplicesPerByte) options.limits.maxSimplicesPerByte = maxSimplicesPerByte;
   return new (std::nothrow) KdmDecoder(options);
 }
 

@@ -17,6 +17,10 @@ export interface DecoderLimits {
   maxVertices?: number;
   maxSimplices?: number;
   maxChunkBytes?: number;
+  /** Vertices per byte of the whole stream (default 1024): raise it for clouds of many coincident points. */
+  maxVerticesPerByte?: number;
+  /** Edges, triangles and tetrahedra per byte of the whole stream (default 1024). */
+  maxSimplicesPerByte?: number;
 }
 
 export interface DecoderOptions {
@@ -67,7 +71,7 @@ export interface Model {
 
 export class Decoder {
   /** Feeds bytes (any split); applies every whole chunk. Throws KdmeshError on bad data. */
-  push(bytes: Uint8Array | ArrayBuffer): Progress;
+  push(bytes: ArrayBuffer | ArrayBufferView): Progress;
   /** Throws KdmeshError('truncated') unless the stream is complete. */
   finish(): void;
   readonly header: Header | null;

@@ -132,6 +132,39 @@ function loadModule() {
 
 const EMPTY_INDICES = new Uint32Array(0);
 
+const limitNames = ['maxVertices', 'maxSimplices', 'maxChunkBytes', 'maxVerticesPerByte', 'maxSimplicesPerByte'];
+
+// The decoder limits as the C API takes them (0: the default), each given
+// one a whole number from 1 to 2^32 - 1.
+function checkedLimits(limits) {
+  if (typeof limits !== 'object' || limits === null) throw new TypeError('limits must be an object');
+  for (const name of Object.keys(limits))
+    if (!limitNames.includes(name)) throw new TypeError(`unknown decoder limit '${name}' (known: ${limitNames.join(', ')})`);
+  const out = {};
+  for (const name of limitNames) {
+    const value = limits[name];
+    if (value === undefined) {
+      out[name] = 0;
+    } else if (typeof value !== 'number' || !Number.isInteger(value) || value < 1 || value > 0xffffffff) {
+      throw new RangeError(`decoder limit ${name} must be a whole number from 1 to 2^32 - 1, not ${String(value)}`);
+    } else {
+      out[name] = value;
+    }
+  }
+  return out;
+}
+
+// The bytes of an ArrayBuffer or of a view of one (a typed array or a
+// DataView), without a copy; anything else is a TypeError rather than
+// bytes made up from it.
+function bytesOf(bytes) {
+  if (bytes instanceof Uint8Array) return bytes;
+  if (ArrayBuffer.isView(bytes)) return new Uint8Array(bytes.buffer, bytes.byteOffset, bytes.byteLength);
+  if (bytes instanceof ArrayBuffer || (typeof SharedArrayBuffer !== 'undefined' && bytes instanceof SharedArrayBuffer))
+    return new Uint8Array(bytes);
+  throw new TypeError(`push() takes an ArrayBuffer or a view of one, not ${bytes === null ? 'null' : typeof bytes}`);
+}
+
 /** A progressive decoder; create it with createDecoder(). */
 export class Decoder {
   #module;
@@ -141,8 +174,9 @@ export class Decoder {
 
   constructor(module, options = {}) {
     this.#module = module;
-    const limits = options.limits ?? {};
-    this.#handle = module._kdm_create(limits.maxVertices >>> 0, limits.maxSimplices >>> 0, limits.maxChunkBytes >>> 0);
+    const limits = checkedLimits(options.limits ?? {});
+    this.#handle = module._kdm_create(limits.maxVertices, limits.maxSimplices, limits.maxChunkBytes,
+                                      limits.maxVerticesPerByte, limits.maxSimplicesPerByte);
     this.#scratch = module._malloc(8 * Math.max(module.records.header.size, module.records.progress.size));
     if (!this.#handle || !this.#scratch) throw new KdmeshError('out-of-memory', 'cannot allocate a decoder');
   }
@@ -172,7 +206,7 @@ export class Decoder {
    */
   push(bytes) {
     const m = this.#live();
-    const view = bytes instanceof Uint8Array ? bytes : new Uint8Array(bytes);
+    const view = bytesOf(bytes);
     const at = m._kdm_input(this.#handle, view.length);
     m.HEAPU8.set(view, at);
     this.#check(m._kdm_push(this.#handle, view.length));
@@ -265,7 +299,10 @@ export async function memoryInUse() {
   return (await loadModule())._kdm_heap_in_use();
 }
 
-/** A new progressive decoder. Options: { limits: { maxVertices, maxSimplices, maxChunkBytes } }. */
+/**
+ * A new progressive decoder. Options: { limits: { maxVertices, maxSimplices, maxChunkBytes,
+ * maxVerticesPerByte, maxSimplicesPerByte } }.
+ */
 export async function createDecoder(options = {}) {
   return new Decoder(await loadModule(), options);
 }

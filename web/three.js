@@ -490,7 +490,10 @@ export class KDMeshLoader extends Loader {
     return this;
   }
 
-  /** Caps for every decoder: { maxVertices, maxSimplices, maxChunkBytes }; a stream beyond one fails with 'limit-exceeded'. */
+  /**
+   * Caps for every decoder: { maxVertices, maxSimplices, maxChunkBytes, maxVerticesPerByte,
+   * maxSimplicesPerByte }; a stream beyond one fails with 'limit-exceeded'.
+   */
   setDecoderLimits(limits) {
     this.decoderLimits = { ...limits };
     return this;

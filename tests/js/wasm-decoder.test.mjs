@@ -3,7 +3,10 @@
 import { test } from 'node:test';
 import assert from 'node:assert/strict';
 import { decode, createDecoder, KdmeshError, memoryInUse } from 'kdmesh';
-import { makeFixtures, nativeDecode } from './fixtures.mjs';
+import { execFileSync } from 'node:child_process';
+import { readFileSync, writeFileSync } from 'node:fs';
+import { join } from 'node:path';
+import { cli, makeFixtures, nativeDecode, workDir } from './fixtures.mjs';
 
 const fixtures = makeFixtures();
 
@@ -235,4 +238,37 @@ test('a download that drops mid-chunk keeps the last whole chunk, reports trunca
   decoder.dispose();
   const retry = await decode(bytes);
   assert.equal(retry.complete, true);
+});
+
+test('a stream announcing more vertices per byte than the limit is refused unless the limit is raised', async () => {
+  // 200,000 identical points code in a few dozen bytes: honest, but past the
+  // default of 1,024 vertices per byte, the bound that stops decompression bombs.
+  const input = join(workDir, 'coincident.xyz');
+  writeFileSync(input, '0.5 0.25 1\n'.repeat(200_000));
+  const kdm = join(workDir, 'coincident.kdm');
+  execFileSync(cli, ['encode', input, '-o', kdm, '-q']);
+  const bytes = readFileSync(kdm);
+  assert.ok(bytes.length * 1024 < 200_000, `${bytes.length} bytes`);
+  await assert.rejects(decode(bytes), (e) => e instanceof KdmeshError && e.code === 'limit-exceeded');
+  const raised = await decode(bytes, { limits: { maxVerticesPerByte: 1 << 20 } });
+  assert.equal(raised.positions.length, 3 * 200_000);
+});
+
+test('limits and pushed bytes of the wrong kind are errors, not made-up values', async () => {
+  for (const limits of [{ maxVertices: -1 }, { maxVertices: 2 ** 32 }, { maxChunkBytes: 1.5 }, { maxSimplices: '9' },
+                        { maxVerticesPerByte: 0 }])
+    await assert.rejects(createDecoder({ limits }), RangeError, JSON.stringify(limits));
+  await assert.rejects(createDecoder({ limits: { maxVertex: 5 } }), TypeError);
+  await assert.rejects(createDecoder({ limits: 5 }), TypeError);
+  const decoder = await createDecoder();
+  for (const wrong of [5, 'abc', null, {}, [1, 2]]) assert.throws(() => decoder.push(wrong), TypeError, String(wrong));
+  assert.equal(decoder.progress.bytesReceived, 0);
+  // Any view of the bytes will do: a DataView of a stream decodes as its bytes.
+  const { bytes } = fixtures['torus-12'];
+  const copy = new ArrayBuffer(bytes.length + 16);
+  new Uint8Array(copy, 8, bytes.length).set(bytes);
+  decoder.push(new DataView(copy, 8, bytes.length));
+  decoder.finish();
+  assert.deepEqual(decoder.snapshot(), await decode(bytes));
+  decoder.dispose();
 });
