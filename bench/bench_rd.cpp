@@ -6,7 +6,10 @@
 // surface plus its vertices (so it over-estimates by up to the sample
 // spacing); all relative to the bounding-box diagonal.
 //
-//   kdmesh_bench_rd [--bits B] [--points N] MODEL
+//   kdmesh_bench_rd [--bits B] [--points N] [--placement predicted|centre] MODEL
+//
+// --placement: where prefixes put vertices whose cells are not yet single
+// grid points (kdmesh::CoarsePlacement; predicted, the default, or centre).
 //
 // Prints CSV: bytes,vertices,mean_error,max_error,hausdorff (hausdorff is
 // empty for models without triangles).
@@ -118,13 +121,20 @@ double directedHausdorff(const std::vector<Point>& from, const NearestPoint& to)
 
 int main(int argc, char** argv) {
   int bits = 12, samples = 40;
+  kdmesh::DecoderOptions decoding;
   std::string path;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--bits" && i + 1 < argc) bits = std::atoi(argv[++i]);
     else if (arg == "--points" && i + 1 < argc) samples = std::max(2, std::atoi(argv[++i]));
+    else if (arg == "--placement" && i + 1 < argc) {
+      const std::string placement = argv[++i];
+      if (placement != "predicted" && placement != "centre") bench::fail("--placement takes predicted or centre");
+      decoding.coarsePlacement =
+          placement == "centre" ? kdmesh::CoarsePlacement::CellCentre : kdmesh::CoarsePlacement::Predicted;
+    }
     else if (arg == "--help" || arg == "-h") {
-      std::printf("usage: kdmesh_bench_rd [--bits B] [--points N] MODEL\n");
+      std::printf("usage: kdmesh_bench_rd [--bits B] [--points N] [--placement predicted|centre] MODEL\n");
       return 0;
     } else path = arg;
   }
@@ -159,7 +169,7 @@ int main(int argc, char** argv) {
   const double first = double(kdmesh::kMaxHeaderBytes + 16), last = double(bytes.size());
   for (int s = 0; s < samples; ++s) {
     const size_t cut = size_t(std::llround(first * std::pow(last / first, double(s) / (samples - 1))));
-    kdmesh::Decoder decoder;
+    kdmesh::Decoder decoder(decoding);
     if (!decoder.push(bytes.data(), cut).ok()) bench::fail("prefix does not decode");
     const kdmesh::Complex prefix = decoder.snapshot();
     const uint32_t count = uint32_t(prefix.vertexCount());

@@ -196,6 +196,40 @@ struct DecodeArgs {
   bool asciiPly = false;
 };
 
+// A prefix of a stream holds simplices of lower dimension than the complete
+// model (edges where triangles collapsed, triangles where tetrahedra did):
+// written to a format that cannot hold some dimension, it keeps what the
+// format holds. Returns what it left out, e.g. "1,204 edges", or "".
+std::string keepWhatTheFormatHolds(kdmesh::io::Format format, kdmesh::Complex& complex) {
+  using kdmesh::io::Format;
+  // Which of edges, triangles and tetrahedra the format's writer takes.
+  bool holds[3] = {true, true, true};
+  switch (format) {
+    case Format::Obj: holds[2] = false; break;
+    case Format::Off: holds[0] = holds[2] = false; break;
+    case Format::Xyz: holds[0] = holds[1] = holds[2] = false; break;
+    case Format::TetGen: holds[0] = holds[1] = false; break;
+    default: break;
+  }
+  std::vector<uint32_t>* lists[3] = {&complex.edges, &complex.triangles, &complex.tetrahedra};
+  static const char* const kNames[3] = {"edges", "triangles", "tetrahedra"};
+  std::string dropped;
+  for (int d = 0; d < 3; ++d) {
+    if (holds[d] || lists[d]->empty()) continue;
+    dropped += (dropped.empty() ? "" : ", ") + std::to_string(lists[d]->size() / size_t(d + 2)) + " " + kNames[d];
+    lists[d]->clear();
+  }
+  if (dropped.empty()) return dropped;
+  // The vertices in no simplex kept are the complex's points now.
+  std::vector<uint8_t> used(complex.vertexCount(), 0);
+  for (const std::vector<uint32_t>* list : lists)
+    for (const uint32_t v : *list) used[v] = 1;
+  complex.points.clear();
+  for (uint32_t v = 0; v < used.size(); ++v)
+    if (!used[v]) complex.points.push_back(v);
+  return dropped;
+}
+
 int runDecode(const DecodeArgs& args) {
   std::vector<uint8_t> bytes;
   std::string error;
@@ -209,6 +243,12 @@ int runDecode(const DecodeArgs& args) {
   const double seconds = secondsSince(start);
   kdmesh::io::WriteOptions writeOptions;
   writeOptions.asciiPly = args.asciiPly;
+  if (prefix) {
+    const std::string dropped = keepWhatTheFormatHolds(kdmesh::io::formatFromPath(args.output), complex);
+    if (!dropped.empty())
+      note(args.output + ": " + kdmesh::io::formatName(kdmesh::io::formatFromPath(args.output)) +
+           " cannot hold them: left out " + dropped + " of the prefix");
+  }
   if (auto s = kdmesh::io::writeFile(args.output, complex, writeOptions); !s.ok())
     return fail(s, args.output);
   if (!gQuiet)

@@ -249,6 +249,58 @@ TEST_F(CliTest, DecodingAPrefixGivesACoarserCloud) {
   }
 }
 
+// A prefix of a surface holds edges where triangles collapsed, and one of
+// a tetrahedral mesh triangles and edges: written to a format that cannot
+// hold them, it keeps what the format holds and says what it left out. A
+// complete model that the format cannot hold is still an error.
+TEST_F(CliTest, APrefixKeepsWhatItsOutputFormatHolds) {
+  writeModel("grid.ply", gridWithHoles(40));
+  runOk("-q encode grid.ply -o grid.kdm --chunk-bytes 256");
+  writeModel("block.mesh", tetrahedralBlock(4, 7));
+  runOk("-q encode block.mesh -o block.kdm --chunk-bytes 256");
+  struct Case {
+    const char *stream, *output, *leftOut;
+  };
+  for (const Case& c : {Case{"grid.kdm", "coarse.off", "edges"}, Case{"grid.kdm", "coarse.xyz", "triangles"},
+                        Case{"block.kdm", "coarse.obj", "tetrahedra"}, Case{"grid.kdm", "coarse.node", "triangles"}}) {
+    SCOPED_TRACE(std::string(c.stream) + " -> " + c.output);
+    Decoder decoder;
+    const std::vector<uint8_t> stream = [&] {
+      const std::string text = readWhole(at(c.stream));
+      return std::vector<uint8_t>(text.begin(), text.end());
+    }();
+    ASSERT_TRUE(decoder.push(stream.data(), stream.size()).ok());
+    // The first chunk boundary whose prefix holds what the format cannot.
+    size_t cut = 0;
+    Complex expected;
+    for (const ChunkInfo& chunk : decoder.chunks()) {
+      Decoder prefix;
+      ASSERT_TRUE(prefix.push(stream.data(), chunk.offset).ok());
+      expected = prefix.snapshot();
+      const std::string leftOut = c.leftOut;
+      if (!(leftOut == "edges" ? expected.edges : leftOut == "triangles" ? expected.triangles : expected.tetrahedra)
+               .empty()) {
+        cut = chunk.offset;
+        break;
+      }
+    }
+    ASSERT_GT(cut, 0u);
+    const CliRun r = runOk(std::string("decode ") + c.stream + " -o " + c.output + " --bytes " + std::to_string(cut));
+    EXPECT_NE(r.err.find("left out"), std::string::npos) << r.err;
+    EXPECT_NE(r.err.find(c.leftOut), std::string::npos) << r.err;
+    // What was kept is the prefix's, vertex for vertex.
+    const Complex written = readModel(c.output);
+    EXPECT_EQ(written.vertexCount(), expected.vertexCount());
+    if (std::string(c.output) == "coarse.off") {
+      EXPECT_EQ(written.triangles.size(), expected.triangles.size());
+    }
+    if (std::string(c.output) == "coarse.node") {
+      EXPECT_TRUE(written.triangles.empty() && written.edges.empty());
+    }
+  }
+  EXPECT_NE(expectError("decode grid.kdm -o whole.xyz").find("XYZ holds only points"), std::string::npos);
+}
+
 TEST_F(CliTest, InfoPrintsHeaderFieldsAndBitsPerVertex) {
   writeModel("cloud.ply", pointCloud(torusSurface(3000, 34)));
   runOk("-q encode cloud.ply -o cloud.kdm --bits 10");
