@@ -5,6 +5,7 @@
 #include <array>
 #include <chrono>
 #include <cmath>
+#include <cctype>
 #include <cinttypes>
 #include <cstdio>
 #include <exception>
@@ -212,11 +213,12 @@ std::string keepWhatTheFormatHolds(kdmesh::io::Format format, kdmesh::Complex& c
     default: break;
   }
   std::vector<uint32_t>* lists[3] = {&complex.edges, &complex.triangles, &complex.tetrahedra};
-  static const char* const kNames[3] = {"edges", "triangles", "tetrahedra"};
+  static const char* const kNames[3][2] = {{"edge", "edges"}, {"triangle", "triangles"}, {"tetrahedron", "tetrahedra"}};
   std::string dropped;
   for (int d = 0; d < 3; ++d) {
     if (holds[d] || lists[d]->empty()) continue;
-    dropped += (dropped.empty() ? "" : ", ") + std::to_string(lists[d]->size() / size_t(d + 2)) + " " + kNames[d];
+    const size_t count = lists[d]->size() / size_t(d + 2);
+    dropped += (dropped.empty() ? "" : ", ") + std::to_string(count) + " " + kNames[d][count > 1];
     lists[d]->clear();
   }
   if (dropped.empty()) return dropped;
@@ -245,9 +247,11 @@ int runDecode(const DecodeArgs& args) {
   writeOptions.asciiPly = args.asciiPly;
   if (prefix) {
     const std::string dropped = keepWhatTheFormatHolds(kdmesh::io::formatFromPath(args.output), complex);
-    if (!dropped.empty())
-      note(args.output + ": " + kdmesh::io::formatName(kdmesh::io::formatFromPath(args.output)) +
-           " cannot hold them: left out " + dropped + " of the prefix");
+    if (!dropped.empty()) {
+      std::string format = kdmesh::io::formatName(kdmesh::io::formatFromPath(args.output));
+      for (char& c : format) c = char(std::toupper(static_cast<unsigned char>(c)));
+      note(args.output + ": left out " + dropped + " of the prefix, which " + format + " cannot hold");
+    }
   }
   if (auto s = kdmesh::io::writeFile(args.output, complex, writeOptions); !s.ok())
     return fail(s, args.output);
