@@ -251,8 +251,8 @@ struct Decoder::State {
   // edges: an edge test by its own walk of the triangles around its first
   // vertex costs one walk per edge, each a chain of cache misses on a
   // large complex.
-  std::vector<bool> edgesInTriangles() const {
-    std::vector<bool> inTriangle(store.size(1), false);
+  std::vector<uint8_t> edgesInTriangles() const {
+    std::vector<uint8_t> inTriangle(store.size(1), 0);
     std::vector<uint32_t> markedBy(nextVertex, kNoSimplex);
     for (uint32_t a = 0; a < nextVertex; ++a) {
       store.forEachIncident(2, a, [&](uint32_t triangle, uint32_t) {
@@ -260,7 +260,7 @@ struct Decoder::State {
         for (int k = 0; k < 3; ++k) markedBy[v[k]] = a;
       });
       store.forEachIncident(1, a, [&](uint32_t edge, uint32_t position) {
-        if (markedBy[store.vertices(1, edge)[1 - position]] == a) inTriangle[edge] = true;
+        if (markedBy[store.vertices(1, edge)[1 - position]] == a) inTriangle[edge] = 1;
       });
     }
     return inTriangle;
@@ -280,7 +280,7 @@ struct Decoder::State {
       if (finished && maximal == 0) continue;
       const bool testFaces = !finished || maximal != store.liveCount(d);
       list.reserve(size_t(finished ? maximal : store.liveCount(d)) * size_t(d + 1));
-      const std::vector<bool> edgeIsFace = d == 1 && testFaces ? edgesInTriangles() : std::vector<bool>{};
+      const std::vector<uint8_t> edgeIsFace = d == 1 && testFaces ? edgesInTriangles() : std::vector<uint8_t>{};
       for (uint32_t simplex = 0; simplex < store.size(d); ++simplex) {
         if (!(store.flags(d, simplex) & SimplexStore::kAlive)) continue;
         if (testFaces && (d == 1 ? bool(edgeIsFace[simplex]) : store.isFace(d, simplex))) continue;
