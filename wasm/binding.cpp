@@ -108,10 +108,13 @@ const std::vector<uint32_t>& indices(const kdmesh::Complex& c, int dimension) {
 
 extern "C" {
 
-// Limits of 0 keep the defaults (kdmesh::DecoderLimits).
+// Limits of 0 keep the defaults (kdmesh::DecoderLimits); `cellCentres`
+// places coarse vertices at their cells' centres (kdmesh::CoarsePlacement).
 EMSCRIPTEN_KEEPALIVE KdmDecoder* kdm_create(uint32_t maxVertices, uint32_t maxSimplices, uint32_t maxChunkBytes,
-                                            uint32_t maxVerticesPerByte, uint32_t maxSimplicesPerByte) {
+                                            uint32_t maxVerticesPerByte, uint32_t maxSimplicesPerByte,
+                                            uint32_t cellCentres) {
   kdmesh::DecoderOptions options;
+  if (cellCentres) options.coarsePlacement = kdmesh::CoarsePlacement::CellCentre;
   if (maxVertices) options.limits.maxVertices = maxVertices;
   if (maxSimplices) options.limits.maxSimplices = maxSimplices;
   if (maxChunkBytes) options.limits.maxChunkBytes = maxChunkBytes;

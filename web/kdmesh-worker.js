@@ -7,7 +7,7 @@
 // bundled into one classic script, see scripts/bundle-worker.mjs) through a
 // Blob URL, or as a module worker from a URL given to setWorkerUrl().
 //
-// Messages in:  {type: 'start', wasm (a WebAssembly.Module), limits?, tetrahedra?, geomorph?}
+// Messages in:  {type: 'start', wasm (a WebAssembly.Module), limits?, coarsePlacement?, tetrahedra?, geomorph?}
 //               (a new stream), {type: 'bytes', bytes}, {type: 'end'},
 //               {type: 'next'} (the page is ready for a snapshot)
 // Messages out: {type: 'header', header}, {type: 'snapshot', model} (the
@@ -187,7 +187,7 @@ function schedule() {
   setTimeout(() => pump(current), 0);
 }
 
-async function start({ wasm, limits, tetrahedra, geomorph }) {
+async function start({ wasm, limits, coarsePlacement, tetrahedra, geomorph }) {
   const current = (job = {
     decoder: null, done: false, wanted: true, changed: false, headerSent: false, pending: [], ending: false, pumping: false,
     wireframe: tetrahedra === 'wireframe',  // also send the edges of the tetrahedra
@@ -198,7 +198,7 @@ async function start({ wasm, limits, tetrahedra, geomorph }) {
       setWasmSource(wasm);
       wasmSet = true;
     }
-    const decoder = await createDecoder({ limits });
+    const decoder = await createDecoder({ limits, coarsePlacement });
     if (current !== job) return decoder.dispose();
     job.decoder = decoder;
     schedule();

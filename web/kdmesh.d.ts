@@ -25,6 +25,11 @@ export interface DecoderLimits {
 
 export interface DecoderOptions {
   limits?: DecoderLimits;
+  /**
+   * Where a vertex whose cell is not yet a grid point is drawn before the stream is complete:
+   * on its neighbours' plane, clamped to the cell ('predicted', the default), or at the cell's centre.
+   */
+  coarsePlacement?: 'predicted' | 'centre';
 }
 
 export interface Header {

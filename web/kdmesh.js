@@ -175,8 +175,11 @@ export class Decoder {
   constructor(module, options = {}) {
     this.#module = module;
     const limits = checkedLimits(options.limits ?? {});
+    const placement = options.coarsePlacement ?? 'predicted';
+    if (placement !== 'predicted' && placement !== 'centre')
+      throw new RangeError(`coarsePlacement must be 'predicted' or 'centre', not ${String(placement)}`);
     this.#handle = module._kdm_create(limits.maxVertices, limits.maxSimplices, limits.maxChunkBytes,
-                                      limits.maxVerticesPerByte, limits.maxSimplicesPerByte);
+                                      limits.maxVerticesPerByte, limits.maxSimplicesPerByte, placement === 'centre' ? 1 : 0);
     this.#scratch = module._malloc(8 * Math.max(module.records.header.size, module.records.progress.size));
     if (!this.#handle || !this.#scratch) throw new KdmeshError('out-of-memory', 'cannot allocate a decoder');
   }
@@ -301,7 +304,9 @@ export async function memoryInUse() {
 
 /**
  * A new progressive decoder. Options: { limits: { maxVertices, maxSimplices, maxChunkBytes,
- * maxVerticesPerByte, maxSimplicesPerByte } }.
+ * maxVerticesPerByte, maxSimplicesPerByte }, coarsePlacement: 'predicted' (default: a vertex
+ * whose cell is not yet a grid point lies on its neighbours' plane, clamped to the cell) or
+ * 'centre' (at the cell's centre) }.
  */
 export async function createDecoder(options = {}) {
   return new Decoder(await loadModule(), options);

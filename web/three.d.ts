@@ -38,6 +38,8 @@ export interface LoadOptions<T> {
   signal?: AbortSignal;
   /** Decoder caps for this load (default: setDecoderLimits'). */
   limits?: DecoderLimits;
+  /** Where vertices of unfinished cells are drawn (kdmesh's DecoderOptions). */
+  coarsePlacement?: 'predicted' | 'centre';
 }
 
 export interface ProgressiveOptions extends LoadOptions<Group> {

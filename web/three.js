@@ -525,7 +525,9 @@ export class KDMeshLoader extends Loader {
    * Starts streaming `url` and returns the group at once. Options: onRefine(model,
    * stats) after each refinement, onHeader(header), onProgress(stats, event),
    * signal (AbortSignal: stops the download and keeps the current level),
-   * limits (decoder caps, default setDecoderLimits'),
+   * limits (decoder caps, default setDecoderLimits'), coarsePlacement ('predicted', the
+   * default, or 'centre': where vertices of unfinished cells are drawn, see kdmesh's
+   * createDecoder),
    * tetrahedra: 'boundary' (default: the faces in exactly one tetrahedron) or
    * 'wireframe' (the boundary plus every edge of the tetrahedra), geomorph
    * (true: new vertices glide from their parent's position over
@@ -721,7 +723,8 @@ export class KDMeshLoader extends Loader {
       acquired.onmessage = onMessage;
       acquired.onerror = (event) => finish(new KdmeshError('worker-failed', `the kdmesh worker failed: ${event.message || 'no message'}`));
       const limits = options.limits ?? this.decoderLimits;
-      acquired.postMessage({ type: 'start', wasm, limits, tetrahedra: options.tetrahedra, geomorph: options.geomorph });
+      acquired.postMessage({ type: 'start', wasm, limits, coarsePlacement: options.coarsePlacement,
+                             tetrahedra: options.tetrahedra, geomorph: options.geomorph });
       for (const piece of early) acquired.postMessage({ type: 'bytes', bytes: piece }, [piece.buffer]);
       early.length = 0;
       worker = acquired;

@@ -239,6 +239,8 @@ function start(load) {
   const options = {
     signal: controller.signal,
     geomorph: $('geomorph').checked,
+    // ?placement=centre draws unfinished vertices at their cells' centres.
+    coarsePlacement: params.get('placement') === 'centre' ? 'centre' : 'predicted',
     tetrahedra: $('wireframe').checked ? 'wireframe' : 'boundary',
     onAnimate: requestRender,
     onHeader(header) {

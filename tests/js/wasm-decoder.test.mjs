@@ -272,3 +272,24 @@ test('limits and pushed bytes of the wrong kind are errors, not made-up values',
   assert.deepEqual(decoder.snapshot(), await decode(bytes));
   decoder.dispose();
 });
+
+test('coarsePlacement: predicted vertices differ from cell centres before the end, complete models are equal', async () => {
+  const { bytes } = fixtures['torus-12'];
+  const predicted = await createDecoder();
+  const centres = await createDecoder({ coarsePlacement: 'centre' });
+  const half = bytes.subarray(0, Math.floor(bytes.length / 2));
+  predicted.push(half);
+  centres.push(half);
+  const p = predicted.snapshot(), c = centres.snapshot();
+  assert.equal(p.vertexCount, c.vertexCount);
+  assert.deepEqual(p.triangles, c.triangles);
+  assert.notDeepEqual(p.positions, c.positions);
+  // The native decoder's default is the predicted placement too.
+  assertSameModel(p, nativeDecode(fixtures['torus-12'].kdm, half.length), 'predicted prefix');
+  predicted.push(bytes.subarray(half.length));
+  centres.push(bytes.subarray(half.length));
+  assert.deepEqual(predicted.snapshot(), centres.snapshot());
+  predicted.dispose();
+  centres.dispose();
+  await assert.rejects(createDecoder({ coarsePlacement: 'center' }), RangeError);
+});
