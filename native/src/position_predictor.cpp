@@ -276,7 +276,9 @@ uint32_t PositionPredictor::across(uint32_t slot, uint32_t a, uint32_t b) {
   if (found == kUnknown) {
     // In the triangle b a c, wound that way, c follows a and b follows c.
     found = kNowhere;
+    uint32_t walked = 0;
     store_.forEachIncident(2, a, [&](uint32_t triangle, uint32_t position) {
+      if (++walked > kMaxAcrossWalk) return true;
       const uint32_t row = position + (store_.flags(2, triangle) & SimplexStore::kFlipped ? 3 : 0);
       if (store_.vertices(2, triangle)[kAfterNext[row]] != b) return false;
       found = triangle * 3 + kNext[row];

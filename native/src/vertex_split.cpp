@@ -273,9 +273,20 @@ void VertexSplitter::orderCodes(bool geometric) {
   codingOrder_.resize(star_.size());
   for (size_t i = 0; i < star_.size(); ++i) codingOrder_[i] = uint32_t(i);
   if (!geometric) return;
-  // An insertion sort: stars are short, and it is stable (edges at equal
-  // angles keep their canonical order) without a buffer.
+  // A stable sort (edges at equal angles keep their canonical order) by
+  // descending steepness. Stars are short: an insertion sort, without a
+  // buffer; a long one (an edge in 100,000 triangles makes one) would take
+  // it quadratic time, so it goes to std::stable_sort, which orders alike
+  // when no cosine is NaN (with one, the insertion sort's order is kept).
   const size_t first = begin_[1], last = begin_[2];
+  auto steepness = [this, first](uint32_t edge) { return std::fabs(cosines_[edge - first]); };
+  if (last - first > kLongStar &&
+      std::none_of(cosines_.begin(), cosines_.begin() + std::ptrdiff_t(last - first),
+                   [](double c) { return std::isnan(c); })) {
+    std::stable_sort(codingOrder_.begin() + std::ptrdiff_t(first), codingOrder_.begin() + std::ptrdiff_t(last),
+                     [&](uint32_t a, uint32_t b) { return steepness(a) > steepness(b); });
+    return;
+  }
   for (size_t i = first + 1; i < last; ++i) {
     const uint32_t edge = codingOrder_[i];
     const double steepness = std::fabs(cosines_[edge - first]);

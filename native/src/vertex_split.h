@@ -197,6 +197,8 @@ class VertexSplitter {
   PositionPredictor& geometry_;
   std::vector<Entry> star_;
   std::vector<double> cosines_, lengths_;  // per edge of the star
+  // Stars with more edges than this are sorted by std::stable_sort.
+  static constexpr size_t kLongStar = 64;
   std::vector<uint32_t> codingOrder_;  // star_ indices in the order codes are taken
   // Fan neighbours beyond two per edge, summed over the star's edges (links
   // hold two). When there are any, the fan neighbours of every edge
