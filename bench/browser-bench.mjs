@@ -11,7 +11,7 @@ import { execFileSync } from 'node:child_process';
 import { mkdtempSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { chromium } from 'playwright-core';
+import { launchChromium } from '../tests/browser/chromium.mjs';
 import { startServer } from '../web/server.mjs';
 
 const root = new URL('..', import.meta.url).pathname;
@@ -30,10 +30,7 @@ execFileSync('draco_encoder', ['-i', dragon, '-o', join(models, 'dragon.drc'), '
 
 const server = await startServer({ port: 0, root: models, host: '127.0.0.1' });
 const base = `http://127.0.0.1:${server.address().port}`;
-const browser = await chromium.launch({
-  executablePath: '/usr/bin/chromium', headless: true,
-  args: ['--no-sandbox', '--disable-background-networking', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
-});
+const browser = await launchChromium();
 
 async function run(url, done, read) {
   const page = await browser.newPage({ viewport: { width: 800, height: 600 } });

@@ -12,7 +12,7 @@ import { execFileSync } from 'node:child_process';
 import { mkdirSync, mkdtempSync, readFileSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { chromium } from 'playwright-core';
+import { launchChromium } from '../tests/browser/chromium.mjs';
 import { startServer } from '../web/server.mjs';
 
 const root = new URL('..', import.meta.url).pathname;
@@ -31,10 +31,7 @@ for (const size of prefixes) writeFileSync(join(models, `dragon-${size}.kdm`), b
 
 const server = await startServer({ port: 0, root: models, host: '127.0.0.1' });
 const base = `http://127.0.0.1:${server.address().port}`;
-const browser = await chromium.launch({
-  executablePath: '/usr/bin/chromium', headless: true,
-  args: ['--no-sandbox', '--disable-background-networking', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
-});
+const browser = await launchChromium();
 try {
   for (const size of prefixes) {
     for (const placement of ['predicted', 'centre']) {

@@ -254,10 +254,11 @@ class PositionPredictor {
   // v a b whose edge it is, under which the answer is remembered.
   uint32_t across(uint32_t slot, uint32_t a, uint32_t b);
   // How many of a's triangles, in list order, across() examines: beyond,
-  // the edge has no triangle across for the predictions. Real stars are far
-  // smaller (a Delaunay tetrahedralization's vertices are in about 70
-  // triangles); without the bound, the vertices around an edge in 100,000
-  // triangles each searched all of them, quadratic work for a small stream.
+  // the edge has no triangle across for the predictions. The reference
+  // meshes, tetrahedral ones included, code the same bits with this bound
+  // as without (64 changes the ball's); without any, the vertices around an
+  // edge in 100,000 triangles each searched all of them, quadratic work for
+  // a small stream.
   static constexpr uint32_t kMaxAcrossWalk = 128;
   static constexpr uint32_t kUnknown = 0xffffffffu, kNowhere = 0xfffffffeu;
   // The models of a one-vertex split: one for the joint class of all

@@ -6,7 +6,7 @@ import { execFileSync } from 'node:child_process';
 import { mkdtempSync, readFileSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { chromium } from 'playwright-core';
+import { launchChromium } from './chromium.mjs';
 import { decode } from 'kdmesh';
 import { startServer } from '../../web/server.mjs';
 import { modelChecksum } from '../../web/model-checksum.js';
@@ -30,11 +30,7 @@ before(async () => {
   execFileSync('mkdir', ['-p', screenshots]);
   server = await startServer({ port: 0, root: models, host: '127.0.0.1' });
   base = `http://127.0.0.1:${server.address().port}`;
-  browser = await chromium.launch({
-    executablePath: '/usr/bin/chromium',
-    headless: true,
-    args: ['--no-sandbox', '--disable-background-networking', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
-  });
+  browser = await launchChromium();
 });
 
 after(async () => {

@@ -11,7 +11,7 @@ import { copyFileSync, mkdirSync, mkdtempSync, readdirSync, readFileSync, rmSync
 import { createServer } from 'node:http';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { chromium } from 'playwright-core';
+import { launchChromium } from '../browser/chromium.mjs';
 import sirv from 'sirv';
 import { decode } from 'kdmesh';
 import { modelChecksum } from '../../web/model-checksum.js';
@@ -39,11 +39,7 @@ before(async () => {
   run(cli, ['encode', join(root, 'build', 'models', 'fandisk.off'), '-o', join(app, 'public', 'model.kdm'), '--bits', '12', '-q'], root);
   decoded = await decode(readFileSync(join(app, 'public', 'model.kdm')));
   expected = modelChecksum(decoded);
-  browser = await chromium.launch({
-    executablePath: '/usr/bin/chromium',
-    headless: true,
-    args: ['--no-sandbox', '--disable-background-networking', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
-  });
+  browser = await launchChromium();
 });
 
 after(async () => {
