@@ -128,6 +128,9 @@ test('a 20 KB point cloud at 400 kbit/s refines at least 5 times; ?model= takes 
   assert.ok(state.levelsSeen.length >= 5, `levels: ${state.levelsSeen}`);
   assert.equal(state.level, state.levelCount);
   assert.equal(state.vertexCount, state.vertexTotal);
+  // The status line is written at the next animation frame after the state.
+  await page.waitForFunction(() => !document.getElementById('status').textContent.includes('so far'), null,
+                             { timeout: 10000 }).catch(() => {});
   const status = await page.textContent('#status');
   assert.match(status, new RegExp(`level ${state.levelCount} of ${state.levelCount} · ([\\d,]+) of \\1 vertices`), status);
   assert.doesNotMatch(status, /so far/);
