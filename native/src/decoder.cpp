@@ -80,6 +80,15 @@ struct Decoder::State {
   std::vector<uint32_t> parents{0};  // the vertex each vertex was split from
   Complex finalComplex;              // simplices, once complete
 
+  // Working memory of snapshots, kept from one to the next: a large
+  // complex's arrays, allocated anew each time, cost a page fault per 4 KiB.
+  struct SnapshotScratch {
+    std::vector<uint32_t> sideStart, sides;  // edgesInTriangles()
+    std::vector<uint8_t> edgeInTriangle;
+    std::vector<float> centre, low, high, sum, normal;  // placeOnNeighbourPlanes()
+    std::vector<uint32_t> degree;
+  } scratch;
+
   explicit State(const DecoderOptions& o) : options(o) {}
 
   bool complete() const {
@@ -246,29 +255,48 @@ struct Decoder::State {
     singleLevelEnd = singles.size();
   }
 
-  // Which edges are sides of a triangle, indexed by edge. Walks each
-  // vertex's triangles once, marking the vertices they hold, then its
-  // edges: an edge test by its own walk of the triangles around its first
-  // vertex costs one walk per edge, each a chain of cache misses on a
-  // large complex.
-  std::vector<uint8_t> edgesInTriangles() const {
-    std::vector<uint8_t> inTriangle(store.size(1), 0);
-    std::vector<uint32_t> markedBy(nextVertex, kNoSimplex);
-    for (uint32_t a = 0; a < nextVertex; ++a) {
-      store.forEachIncident(2, a, [&](uint32_t triangle, uint32_t) {
+  // Which edges are sides of a triangle, indexed by edge (in
+  // scratch.edgeInTriangle). Each triangle's three sides are listed under
+  // their lower vertex by a counting sort in flat arrays; an edge is a side
+  // if its upper vertex is in its lower vertex's list. Flat passes, since
+  // walking the vertices' linked incidence lists instead is a chain of
+  // dependent cache misses per vertex on a large complex.
+  const std::vector<uint8_t>& edgesInTriangles() {
+    std::vector<uint32_t>& start = scratch.sideStart;
+    std::vector<uint32_t>& sides = scratch.sides;
+    start.assign(size_t(nextVertex) + 1, 0);
+    auto forEachSide = [this](auto&& visit) {
+      for (uint32_t triangle = 0; triangle < store.size(2); ++triangle) {
+        if (!(store.flags(2, triangle) & SimplexStore::kAlive)) continue;
         const uint32_t* v = store.vertices(2, triangle);
-        for (int k = 0; k < 3; ++k) markedBy[v[k]] = a;
-      });
-      store.forEachIncident(1, a, [&](uint32_t edge, uint32_t position) {
-        if (markedBy[store.vertices(1, edge)[1 - position]] == a) inTriangle[edge] = 1;
-      });
+        for (int k = 0; k < 3; ++k) {
+          const uint32_t a = v[k], b = v[k == 2 ? 0 : k + 1];
+          visit(std::min(a, b), std::max(a, b));
+        }
+      }
+    };
+    forEachSide([&](uint32_t low, uint32_t) { ++start[size_t(low) + 1]; });
+    for (size_t v = 1; v < start.size(); ++v) start[v] += start[v - 1];
+    sides.resize(start.back());
+    // Filling moves each list's start to its end: list v is then
+    // [start[v - 1], start[v]).
+    forEachSide([&](uint32_t low, uint32_t high) { sides[start[low]++] = high; });
+    std::vector<uint8_t>& inTriangle = scratch.edgeInTriangle;
+    inTriangle.assign(store.size(1), 0);
+    for (uint32_t edge = 0; edge < store.size(1); ++edge) {
+      if (!(store.flags(1, edge) & SimplexStore::kAlive)) continue;
+      const uint32_t* v = store.vertices(1, edge);
+      const uint32_t low = std::min(v[0], v[1]), high = std::max(v[0], v[1]);
+      const uint32_t* first = sides.data() + (low == 0 ? 0 : start[low - 1]);
+      const uint32_t* last = sides.data() + start[low];
+      inTriangle[edge] = std::find(first, last, high) != last;
     }
     return inTriangle;
   }
 
   // Appends the maximal simplices of the current complex, oriented, and its
   // isolated vertices.
-  void appendSimplices(Complex& out) const {
+  void appendSimplices(Complex& out) {
     std::vector<uint32_t>* lists[4] = {nullptr, &out.edges, &out.triangles, &out.tetrahedra};
     for (int d = 1; d <= 3; ++d) {
       std::vector<uint32_t>& list = *lists[d];
@@ -278,9 +306,10 @@ struct Decoder::State {
       const uint32_t maximal = header.simplexCounts[size_t(d)];
       const bool finished = complete();
       if (finished && maximal == 0) continue;
-      const bool testFaces = !finished || maximal != store.liveCount(d);
+      // A simplex can be a face only while simplices one dimension up exist.
+      const bool testFaces = d < 3 && store.liveCount(d + 1) > 0 && (!finished || maximal != store.liveCount(d));
       list.reserve(size_t(finished ? maximal : store.liveCount(d)) * size_t(d + 1));
-      const std::vector<uint8_t> edgeIsFace = d == 1 && testFaces ? edgesInTriangles() : std::vector<uint8_t>{};
+      const std::vector<uint8_t>& edgeIsFace = d == 1 && testFaces ? edgesInTriangles() : scratch.edgeInTriangle;
       for (uint32_t simplex = 0; simplex < store.size(d); ++simplex) {
         if (!(store.flags(d, simplex) & SimplexStore::kAlive)) continue;
         if (testFaces && (d == 1 ? bool(edgeIsFace[simplex]) : store.isFace(d, simplex))) continue;
@@ -329,12 +358,19 @@ struct Decoder::State {
   // tips. A vertex in no triangle goes to its neighbours' centroid; one in
   // no edge stays at its cell's centre. Float32 streams place in float
   // values, whose cells are intervals too.
-  void placeOnNeighbourPlanes(std::vector<float>& positions) const {
+  void placeOnNeighbourPlanes(std::vector<float>& positions) {
     const size_t n = nextVertex;
     // Floats: the cells' bounds are floats, and the sums need no more for
     // a picture (half the memory to touch).
-    std::vector<float> centre(n * 3), low(n * 3), high(n * 3), sum(n * 3, 0.0f), normal(n * 3, 0.0f);
-    std::vector<uint32_t> degree(n, 0);
+    std::vector<float>&centre = scratch.centre, &low = scratch.low, &high = scratch.high;
+    std::vector<float>&sum = scratch.sum, &normal = scratch.normal;
+    std::vector<uint32_t>& degree = scratch.degree;
+    centre.resize(n * 3);
+    low.resize(n * 3);
+    high.resize(n * 3);
+    sum.assign(n * 3, 0.0f);
+    normal.assign(n * 3, 0.0f);
+    degree.assign(n, 0);
     forEachCurrentCell([&](const Cell& cell, int cellLevel) {
       for (int a = 0; a < 3; ++a) {
         uint32_t lo, hi;
@@ -392,7 +428,10 @@ struct Decoder::State {
   // copying them, for decode(), whose decoder is discarded next (the copy
   // was 12 bytes per triangle of peak memory).
   void snapshot(Complex& out, bool takeFinal) {
-    out = Complex{};
+    // Emptied, not replaced: a caller that snapshots level after level into
+    // one Complex reuses its memory.
+    for (std::vector<uint32_t>* list : {&out.points, &out.edges, &out.triangles, &out.tetrahedra}) list->clear();
+    out.positions.clear();
     if (!hasHeader) return;
     const bool finished = complete();
     if (connectivity) {

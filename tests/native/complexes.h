@@ -202,11 +202,24 @@ inline void expectPrefixesAreProjections(const Complex& input, EncodeOptions o) 
   std::vector<uint64_t> cuts;
   for (const ChunkInfo& chunk : full.chunks()) cuts.push_back(chunk.offset);
   cuts.push_back(encoded.bytes.size());
+  // One decoder fed chunk by chunk snapshots into one Complex, reused: it
+  // must match a fresh decoder's snapshot of the same prefix.
+  Decoder streaming;
+  Complex reused;
+  uint64_t streamed = 0;
   for (const uint64_t cut : cuts) {
     Decoder decoder;
     ASSERT_TRUE(decoder.push(encoded.bytes.data(), cut).ok());
+    ASSERT_TRUE(streaming.push(encoded.bytes.data() + streamed, cut - streamed).ok());
+    streamed = cut;
     if (!decoder.hasHeader()) continue;
     const Complex prefix = decoder.snapshot();
+    streaming.snapshot(reused);
+    EXPECT_EQ(reused.positions, prefix.positions) << "prefix of " << cut << " bytes";
+    EXPECT_EQ(reused.points, prefix.points);
+    EXPECT_EQ(reused.edges, prefix.edges);
+    EXPECT_EQ(reused.triangles, prefix.triangles);
+    EXPECT_EQ(reused.tetrahedra, prefix.tetrahedra);
     const uint32_t count = uint32_t(prefix.vertexCount());
     auto ancestor = [&](uint32_t v) {
       while (v >= count) v = parents[v];
