@@ -106,9 +106,22 @@ function edgesOfTetrahedra(tetrahedra) {
   return Uint32Array.from(out);
 }
 
+// While received bytes wait to be decoded, handing over snapshots may take
+// at most this share of the worker's time: a snapshot waits until decoding
+// since the previous one has taken (1 - share) / share times as long as that
+// one did. With nothing waiting, a snapshot delays no decoding and goes at
+// once; so does the last.
+const kHandOverShare = 0.1;
+
+function snapshotDue() {
+  return !job.pending.length || job.decoder.progress.complete ||
+    job.decodeMs * kHandOverShare >= job.handOverMs * (1 - kHandOverShare);
+}
+
 function sendSnapshot() {
   const { decoder, wireframe, geomorph } = job;
-  if (!decoder || !job.wanted || !job.changed) return;
+  if (!decoder || !job.wanted || !job.changed || !snapshotDue()) return;
+  const began = performance.now();
   const live = decoder.snapshot({ copy: false });  // views, valid until the next call on the decoder
   const boundary = live.tetrahedra.length ? boundaryOfTetrahedra(live.tetrahedra) : new Uint32Array(0);
   const tetrahedronEdges = live.tetrahedra.length && wireframe ? edgesOfTetrahedra(live.tetrahedra) : new Uint32Array(0);
@@ -131,6 +144,8 @@ function sendSnapshot() {
   };
   job.wanted = false;
   job.changed = false;
+  job.decodeMs = 0;
+  job.handOverMs = performance.now() - began;
   const buffers = [positions, points, edges, triangles, model.tetrahedra, model.normals, model.parents]
     .map((a) => a.buffer).filter((b, i, all) => b.byteLength && all.indexOf(b) === i);
   postMessage({ type: 'snapshot', model }, buffers);
@@ -162,7 +177,9 @@ function pump(current) {
   try {
     if (pending.length) {
       const before = decoder.progress.chunksApplied;
+      const began = performance.now();
       decoder.push(pending.shift());
+      job.decodeMs += performance.now() - began;
       if (!job.headerSent && decoder.header) {
         job.headerSent = true;
         postMessage({ type: 'header', header: decoder.header });
@@ -190,6 +207,7 @@ function schedule() {
 async function start({ wasm, limits, coarsePlacement, tetrahedra, geomorph }) {
   const current = (job = {
     decoder: null, done: false, wanted: true, changed: false, headerSent: false, pending: [], ending: false, pumping: false,
+    decodeMs: 0, handOverMs: 0,  // decoding since the last snapshot, and that snapshot's cost (snapshotDue())
     wireframe: tetrahedra === 'wireframe',  // also send the edges of the tetrahedra
     geomorph: Boolean(geomorph),            // also send every vertex's parent
   });
