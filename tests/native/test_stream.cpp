@@ -8,6 +8,7 @@
 
 #include "complexes.h"
 #include "container.h"
+#include "mutations.h"
 #include "shapes.h"
 #include "test_support.h"
 
@@ -311,86 +312,32 @@ TEST(Stream, NoiseWithValidChecksumsNeverBreaksTheDecoder) {
 }
 
 // A mutation suite: 600 streams of a mesh, each with one kind of change
-// and checksums made valid again — header fields (counts, extents, body
-// size, chunk count, grid), chunks swapped or dropped and re-checksummed at
-// their new places, payload bytes replaced. Every one must decode to a
+// and checksums made valid again (mutations.h). Every one must decode to a
 // valid complex of the header's counts or fail with a documented code,
 // never crash (ASan and UBSan run this in CI), and its work is bounded by
-// the splits the chunk frames allow.
+// the splits the chunk frames allow. tests/js/mutations.test.mjs gives the
+// same streams to the WebAssembly decoder.
 TEST(Stream, MutatedStreamsWithValidChecksumsFailCleanly) {
-  EncodeOptions options;
-  options.bits = 10;
-  options.chunkBytes = 256;
-  const EncodeResult encoded = encode(torusMesh(16, 28), options);
-  ASSERT_TRUE(encoded.status.ok());
-  const std::vector<uint8_t>& bytes = encoded.bytes;
-  Decoder reference;
-  ASSERT_TRUE(reference.push(bytes.data(), bytes.size()).ok());
-  const std::vector<ChunkInfo> chunks = reference.chunks();
-  const Header honest = reference.header();
-  std::mt19937 rng(29);
+  const std::vector<MutatedStream> streams = mutatedStreams(mutationSubject(), 600, 29);
+  ASSERT_EQ(streams.size(), 600u);
   int decoded = 0;
-  for (int trial = 0; trial < 600; ++trial) {
-    std::vector<uint8_t> body(bytes.begin() + honest.headerBytes, bytes.end());
-    Header h = honest;
-    switch (trial % 3) {
-      case 0: {  // a header field
-        const uint32_t value = rng() % 4 == 0 ? rng() : rng() % 64;
-        switch (rng() % 8) {
-          case 0: h.vertexCount = value; break;
-          case 1: h.simplexCounts[rng() % 4] = value; break;
-          case 2: h.gridMax[rng() % 3] = value; break;
-          case 3: h.bodyBytes = value; break;
-          case 4: h.chunkCount = value; break;
-          case 5: h.bits = uint8_t(value); break;
-          case 6: h.maxDimension = uint8_t(value % 4); break;
-          default: h.step = std::ldexp(double(value), int(rng() % 200) - 100); break;
-        }
-        break;
-      }
-      case 1: {  // two chunks swapped (or one dropped), checksums for their new places
-        const size_t a = rng() % chunks.size(), b = rng() % chunks.size();
-        std::vector<std::vector<uint8_t>> pieces;
-        for (size_t i = 0; i < chunks.size(); ++i) {
-          const size_t begin = chunks[i].offset - honest.headerBytes;
-          const size_t end = i + 1 < chunks.size() ? chunks[i + 1].offset - honest.headerBytes : body.size();
-          pieces.emplace_back(body.begin() + std::ptrdiff_t(begin), body.begin() + std::ptrdiff_t(end));
-        }
-        std::swap(pieces[a], pieces[b]);
-        if (rng() % 2) pieces.erase(pieces.begin() + std::ptrdiff_t(b));
-        body.clear();
-        for (uint32_t i = 0; i < pieces.size(); ++i) {
-          std::vector<uint8_t>& piece = pieces[i];
-          const size_t checked = piece.size() - kChunkChecksumBytes;
-          writeChunkChecksum(piece.data(), checked, i, piece.data() + checked);
-          body.insert(body.end(), piece.begin(), piece.end());
-        }
-        break;
-      }
-      default: {  // payload bytes replaced, checksums recomputed
-        for (uint32_t i = 0; i < chunks.size(); ++i) {
-          uint8_t* chunk = body.data() + (chunks[i].offset - honest.headerBytes);
-          const size_t checked = chunks[i].frameBytes - kChunkChecksumBytes + chunks[i].payloadBytes;
-          for (size_t k = chunks[i].frameBytes - kChunkChecksumBytes; k < checked; ++k)
-            if (rng() % 16 == 0) chunk[k] = uint8_t(rng());
-          writeChunkChecksum(chunk, checked, i, chunk + checked);
-        }
-      }
-    }
-    uint8_t header[kMaxHeaderBytes];
-    std::vector<uint8_t> hostile(header, header + writeHeader(h, header));
-    hostile.insert(hostile.end(), body.begin(), body.end());
+  for (size_t trial = 0; trial < streams.size(); ++trial) {
+    const std::vector<uint8_t>& hostile = streams[trial].bytes;
     Complex out;
     const Status s = decode(hostile.data(), hostile.size(), out);
     if (s.ok()) {
       ++decoded;
+      Header h;
+      size_t size = 0;
+      ASSERT_TRUE(headerSize(hostile.data(), size).ok());
+      ASSERT_TRUE(readHeader(hostile.data(), size, DecoderLimits{}, h).ok());
       EXPECT_EQ(out.vertexCount(), h.vertexCount) << trial;
       EXPECT_EQ(out.simplexCount(2), h.simplexCounts[2]) << trial;
     } else {
       EXPECT_TRUE(s.code == ErrorCode::CorruptHeader || s.code == ErrorCode::CorruptChunk ||
                   s.code == ErrorCode::LimitExceeded || s.code == ErrorCode::TrailingBytes ||
                   s.code == ErrorCode::Truncated)
-          << trial << ": " << errorCodeName(s.code) << " " << s.message;
+          << trial << " (" << streams[trial].kind << "): " << errorCodeName(s.code) << " " << s.message;
     }
   }
   EXPECT_LT(decoded, 600);  // the mutations are not all harmless
