@@ -6,7 +6,9 @@
 #include <limits>
 #include <random>
 
+#include "kd_order.h"
 #include "shapes.h"
+#include "split_schedule.h"
 #include "test_support.h"
 
 namespace kdmesh::test {
@@ -159,6 +161,31 @@ TEST(PointCodec, RejectsBadOptionsAndEmptyInput) {
 TEST(PointCodec, EncodingIsDeterministic) {
   const std::vector<float> p = clusteredCloud(5000, 4);
   EXPECT_EQ(encodeOrDie(pointCloud(p), EncodeOptions{}), encodeOrDie(pointCloud(p), EncodeOptions{}));
+}
+
+// The encoder lists cells in the order of kdOrder() (kd_order.h); the
+// decoder keeps its cells in an order of its own making (children after
+// their parents' earlier siblings, one-vertex cells merged in). A complete
+// point cloud without coincident points comes out in the decoder's cell
+// order, which must be the encoder's: sorted by kdOrder() it stays as it is.
+TEST(PointCodec, DecodedCellsFollowTheEncodersKdOrder) {
+  for (const uint32_t seed : {31u, 32u}) {
+    EncodeOptions options;
+    options.bits = 16;
+    const std::vector<float> input = seed == 31 ? uniformCloud(3000, seed) : sphereSurface(3000, seed);
+    const std::vector<uint8_t> bytes = encodeOrDie(pointCloud(input), options);
+    Decoder decoder;
+    ASSERT_TRUE(decoder.push(bytes.data(), bytes.size()).ok());
+    ASSERT_TRUE(decoder.complete());
+    const Header& h = decoder.header();
+    const Complex decoded = decoder.snapshot();
+    std::vector<uint32_t> coords(decoded.positions.size());
+    for (size_t i = 0; i < coords.size(); ++i)
+      coords[i] = uint32_t(std::llround((double(decoded.positions[i]) - h.origin[i % 3]) / h.step));
+    const KdOrder order = kdOrder(coords, SplitSchedule(h));
+    ASSERT_EQ(std::adjacent_find(order.keys.begin(), order.keys.end()), order.keys.end()) << "coincident points";
+    for (uint32_t i = 0; i < order.vertices.size(); ++i) ASSERT_EQ(order.vertices[i], i) << "seed " << seed;
+  }
 }
 
 }  // namespace
