@@ -64,6 +64,7 @@ void visitHeader(const kdmesh::Header& h, Field&& field) {
   field("totalBytes", Values{double(h.totalBytes())});
   field("chunkCount", Values{double(h.chunkCount)});
   field("depth", Values{double(h.depth())});  // kd-tree levels: the last level of a complete stream
+  field("attributeCount", Values{double(h.attributeCount)});
 }
 
 template <class Field>
@@ -178,6 +179,20 @@ EMSCRIPTEN_KEEPALIVE uint32_t kdm_index_count(KdmDecoder* d, int dimension) {
 }
 EMSCRIPTEN_KEEPALIVE const uint32_t* kdm_indices(KdmDecoder* d, int dimension) {
   return indices(d->snapshot, dimension).data();
+}
+// The snapshot's vertex attributes: how many, and each one's name, type
+// (kdmesh::AttributeType), components and values (vertex count · components
+// of the type, in WebAssembly memory).
+EMSCRIPTEN_KEEPALIVE uint32_t kdm_attribute_count(KdmDecoder* d) { return uint32_t(d->snapshot.attributes.size()); }
+EMSCRIPTEN_KEEPALIVE const char* kdm_attribute_name(KdmDecoder* d, uint32_t a) {
+  return d->snapshot.attributes[a].name.c_str();
+}
+EMSCRIPTEN_KEEPALIVE int kdm_attribute_type(KdmDecoder* d, uint32_t a) { return int(d->snapshot.attributes[a].type); }
+EMSCRIPTEN_KEEPALIVE int kdm_attribute_components(KdmDecoder* d, uint32_t a) {
+  return d->snapshot.attributes[a].components;
+}
+EMSCRIPTEN_KEEPALIVE const uint8_t* kdm_attribute_values(KdmDecoder* d, uint32_t a) {
+  return d->snapshot.attributes[a].values.data();
 }
 EMSCRIPTEN_KEEPALIVE uint32_t kdm_parent_count(KdmDecoder* d) { return uint32_t(d->decoder.vertexParents().size()); }
 EMSCRIPTEN_KEEPALIVE const uint32_t* kdm_parents(KdmDecoder* d) { return d->decoder.vertexParents().data(); }

@@ -44,6 +44,14 @@ export interface Header {
   chunkCount: number;
   /** Levels of the kd-tree: `progress.level` reaches it when the stream is complete. */
   depth: number;
+  /** Vertex attributes the stream carries (their names arrive with the first snapshot). */
+  attributeCount: number;
+}
+
+/** A vertex attribute's values: vertexCount · itemSize of its type, as a three.js BufferAttribute takes them. */
+export interface VertexAttribute {
+  array: Uint8Array | Int8Array | Uint16Array | Int16Array | Uint32Array | Int32Array | Float32Array;
+  itemSize: number;
 }
 
 export interface Progress {
@@ -70,6 +78,8 @@ export interface Model {
   triangles: Uint32Array;
   /** 4 indices per tetrahedron, in the input's orientation. */
   tetrahedra: Uint32Array;
+  /** Vertex attributes by name (colours, normals, texture coordinates, ...), exact at every level. */
+  attributes: Record<string, VertexAttribute>;
   complete: boolean;
   stats: { bytes: number; level: number; chunks: number; errorBound: number; bitsPerVertex: number };
 }

@@ -131,6 +131,8 @@ function loadModule() {
 }
 
 const EMPTY_INDICES = new Uint32Array(0);
+// Typed arrays of kdmesh::AttributeType's values, in its order.
+const ATTRIBUTE_ARRAYS = [Uint8Array, Int8Array, Uint16Array, Int16Array, Uint32Array, Int32Array, Float32Array];
 
 const limitNames = ['maxVertices', 'maxSimplices', 'maxChunkBytes', 'maxVerticesPerByte', 'maxSimplicesPerByte'];
 
@@ -239,7 +241,9 @@ export class Decoder {
 
   /**
    * The model at the current level: { vertexCount, positions, points, edges,
-   * triangles, tetrahedra, complete, stats }. With { copy: false } the arrays
+   * triangles, tetrahedra, attributes, complete, stats }. `attributes` maps
+   * each vertex attribute's name to { array, itemSize } (a typed array of
+   * vertexCount · itemSize values, the type's own: Uint8Array for uint8, ...). With { copy: false } the arrays
    * are views of WebAssembly memory, valid only until the next call on this
    * decoder; by default they are copies the caller may keep.
    */
@@ -254,6 +258,15 @@ export class Decoder {
       const count = m._kdm_index_count(h, dimension);
       return count ? take(new Uint32Array(m.HEAPU8.buffer, m._kdm_indices(h, dimension), count)) : EMPTY_INDICES;
     };
+    // Vertex attributes by name: { array, itemSize }, as a three.js
+    // BufferAttribute takes them.
+    const attributes = {};
+    for (let a = 0, count = m._kdm_attribute_count(h); a < count; ++a) {
+      const Type = ATTRIBUTE_ARRAYS[m._kdm_attribute_type(h, a)];
+      const itemSize = m._kdm_attribute_components(h, a);
+      const array = take(new Type(m.HEAPU8.buffer, m._kdm_attribute_values(h, a), vertexCount * itemSize));
+      attributes[m.UTF8ToString(m._kdm_attribute_name(h, a))] = { array, itemSize };
+    }
     const progress = this.progress;
     return {
       vertexCount,
@@ -262,6 +275,7 @@ export class Decoder {
       edges: indices(1),
       triangles: indices(2),
       tetrahedra: indices(3),
+      attributes,
       complete: progress.complete,
       stats: {
         bytes: progress.bytesConsumed,

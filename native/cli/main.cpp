@@ -261,6 +261,17 @@ int runDecode(const DecodeArgs& args) {
   return 0;
 }
 
+// A JSON string's contents: attribute names are printable ASCII (the
+// decoder checks), so only quotes and backslashes need escaping.
+std::string jsonEscaped(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out;
+}
+
 // JSON has no inf or nan: those (from an empty model) print as null.
 std::string jsonNumber(double v) {
   if (!std::isfinite(v)) return "null";
@@ -296,6 +307,14 @@ int runInfo(const std::string& input, bool json, bool perLevel) {
       std::printf("  \"origin\": [%s, %s, %s],\n  \"step\": %s,\n", jsonNumber(h.origin[0]).c_str(),
                   jsonNumber(h.origin[1]).c_str(), jsonNumber(h.origin[2]).c_str(),
                   jsonNumber(h.step).c_str());
+    const kdmesh::Complex final = decoder.snapshot();
+    std::printf("  \"attributes\": [");
+    for (size_t a = 0; a < final.attributes.size(); ++a)
+      std::printf("%s{\"name\": \"%s\", \"type\": \"%s\", \"components\": %u, \"bitsPerVertex\": %s}",
+                  a ? ", " : "", jsonEscaped(final.attributes[a].name).c_str(),
+                  kdmesh::attributeTypeName(final.attributes[a].type), unsigned(final.attributes[a].components),
+                  jsonNumber(cost.attributeBits[a] / n).c_str());
+    std::printf("],\n");
     std::printf("  \"bitsPerVertex\": {\"total\": %s, \"geometry\": %s, \"connectivity\": %s},\n",
                 jsonNumber(8.0 * double(bytes.size()) / n).c_str(),
                 jsonNumber(cost.geometryBits / n).c_str(),
@@ -342,9 +361,16 @@ int runInfo(const std::string& input, bool json, bool perLevel) {
     std::printf("quantization    exact float32 (x %d, y %d, z %d bits of float image)\n",
                 h.axisBits(0), h.axisBits(1), h.axisBits(2));
   std::printf("kd-tree levels  %d\n", h.depth());
-  std::printf("bits/vertex     %.3f total: %.3f geometry, %.3f connectivity, %.3f container\n",
-              8.0 * double(bytes.size()) / n, cost.geometryBits / n, cost.connectivityBits / n,
-              (8.0 * double(bytes.size()) - cost.geometryBits - cost.connectivityBits) / n);
+  double attributeBits = 0;
+  for (const double bits : cost.attributeBits) attributeBits += bits;
+  std::printf("bits/vertex     %.3f total: %.3f geometry, %.3f connectivity, %.3f attributes, %.3f container\n",
+              8.0 * double(bytes.size()) / n, cost.geometryBits / n, cost.connectivityBits / n, attributeBits / n,
+              (8.0 * double(bytes.size()) - cost.geometryBits - cost.connectivityBits - attributeBits) / n);
+  const kdmesh::Complex final = decoder.snapshot();
+  for (size_t a = 0; a < final.attributes.size(); ++a)
+    std::printf("%s%s (%u %s) %.3f bits/vertex\n", a == 0 ? "attributes      " : "                ",
+                oneLine(final.attributes[a].name).c_str(), unsigned(final.attributes[a].components),
+                kdmesh::attributeTypeName(final.attributes[a].type), cost.attributeBits[a] / n);
   if (h.maxDimension > 0) {
     // As the paper's Table 1: which operator undid each of the n - 1 merges.
     std::printf("operators       %" PRIu64 " vertex splits (%.1f %% of %u merges), of which %" PRIu64

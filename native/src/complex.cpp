@@ -15,6 +15,32 @@ size_t Complex::simplexCount(int dimension) const {
   }
 }
 
+size_t attributeTypeBytes(AttributeType type) {
+  switch (type) {
+    case AttributeType::UInt8:
+    case AttributeType::Int8: return 1;
+    case AttributeType::UInt16:
+    case AttributeType::Int16: return 2;
+    case AttributeType::UInt32:
+    case AttributeType::Int32:
+    case AttributeType::Float32: return 4;
+  }
+  return 0;
+}
+
+const char* attributeTypeName(AttributeType type) {
+  switch (type) {
+    case AttributeType::UInt8: return "uint8";
+    case AttributeType::Int8: return "int8";
+    case AttributeType::UInt16: return "uint16";
+    case AttributeType::Int16: return "int16";
+    case AttributeType::UInt32: return "uint32";
+    case AttributeType::Int32: return "int32";
+    case AttributeType::Float32: return "float32";
+  }
+  return "unknown";
+}
+
 const char* errorCodeName(ErrorCode code) {
   switch (code) {
     case ErrorCode::Ok: return "ok";

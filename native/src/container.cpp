@@ -15,8 +15,9 @@ static_assert(kHeaderPrefixBytes == kOffHeaderBytes + 1, "header prefix");
 // The fixed bytes, ten 32-bit varints (the body size's has at most 9 bytes),
 // grid parameters (float32 mode's are three 32-bit varints) and checksum.
 static_assert(kMaxHeaderBytes == kHeaderPrefixBytes + 2 + 9 * 5 + 9 + 20 + 4, "header size");
-// The mode byte: quantization in bits 0-1, the highest dimension in bits 2-3.
-constexpr uint8_t kModeReserved = 0xf0;
+// The mode byte: quantization in bits 0-1, the highest dimension in bits
+// 2-3, the number of vertex attributes in bits 4-7.
+static_assert(kMaxAttributes == 15, "the attribute count has four bits");
 
 void put16(uint8_t* p, uint16_t v) {
   p[0] = uint8_t(v);
@@ -130,8 +131,9 @@ Status validate(const Header& h, const DecoderLimits& limits) {
                          "stream has " + std::to_string(simplices) +
                              " simplices, more than the decoder limit of " +
                              std::to_string(limits.maxSimplices));
+  // A body without chunks holds the attribute table alone, if any.
   if (h.bodyBytes < uint64_t(h.chunkCount) * (2 + kChunkChecksumBytes) ||
-      (h.chunkCount == 0) != (h.bodyBytes == 0))
+      (h.chunkCount == 0 && h.attributeCount == 0) != (h.bodyBytes == 0))
     return corrupt("chunk count does not fit the body size");
   // What a stream decodes to is bounded by its size: a complete decode
   // needs every byte the header announces.
@@ -151,6 +153,11 @@ Status validate(const Header& h, const DecoderLimits& limits) {
                              " simplices: more than the decoder limit of " +
                              std::to_string(limits.maxSimplicesPerByte) + " simplices per byte");
   if (h.chunkCount == 0 && h.depth() != 0) return corrupt("stream has no chunks");
+  // Vertices of a stream with attributes are told apart by splits, also
+  // coincident ones; each attribute takes at least 5 bytes of the table.
+  if (h.attributeCount > 0 && h.vertexCount > 1 && h.chunkCount == 0) return corrupt("stream has no chunks");
+  if (h.bodyBytes < uint64_t(h.attributeCount) * 5 + (h.attributeCount > 0 ? 4 : 0))
+    return corrupt("the body cannot hold the attribute table");
   return Status::success();
 }
 
@@ -160,7 +167,7 @@ size_t writeHeader(const Header& h, uint8_t* out) {
   std::memcpy(out, kMagic, 4);
   put16(out + kOffVersion, kFormatVersion);
   uint8_t* at = out + kHeaderPrefixBytes;
-  *at++ = uint8_t(uint8_t(h.quantization) | h.maxDimension << 2);
+  *at++ = uint8_t(uint8_t(h.quantization) | h.maxDimension << 2 | h.attributeCount << 4);
   *at++ = h.bits;
   at += putVarint(at, h.vertexCount);
   for (const uint32_t count : h.simplexCounts) at += putVarint(at, count);
@@ -205,9 +212,9 @@ Status readHeader(const uint8_t* in, size_t size, const DecoderLimits& limits, H
   const uint8_t* const end = in + size - 4;
   if (end - at < 2) return corrupt("truncated fields");
   const uint8_t mode = *at++;
-  if (mode & kModeReserved) return corrupt("unknown flags");
   h.quantization = Quantization(mode & 3);
   h.maxDimension = uint8_t(mode >> 2 & 3);
+  h.attributeCount = uint8_t(mode >> 4);
   h.bits = *at++;
   bool ok = true;
   auto u32 = [&](uint32_t& field) {

@@ -12,7 +12,7 @@
 
 namespace kdmesh {
 
-constexpr uint16_t kFormatVersion = 17;
+constexpr uint16_t kFormatVersion = 18;
 
 // Writes the header (its headerBytes field is ignored) and returns its size.
 size_t writeHeader(const Header& header, uint8_t* out /* kMaxHeaderBytes */);

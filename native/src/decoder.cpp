@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 
+#include "attributes.h"
 #include "container.h"
 #include "count_coder.h"
 #include "kdmesh/kdmesh.h"
@@ -28,7 +29,7 @@ struct Cell {
   // How many one-vertex cells precede this cell in kd-tree order; for a new
   // one-vertex cell, where it goes among those of the previous level.
   uint32_t singlesBefore;
-  uint32_t vertex;  // id in the complex (connectivity streams only)
+  uint32_t vertex;  // id in the complex (streams with connectivity or attributes)
 };
 
 // Every split codes at least one binary decision, and a decision costs at
@@ -73,6 +74,14 @@ struct Decoder::State {
   // Connectivity: the complex on the current cells. Levels past the last
   // geometric one split cells of coincident vertices in halves.
   bool connectivity = false;
+  // Vertices have ids (and coincident ones their own levels) in streams
+  // with connectivity or attributes.
+  bool named = false;
+  // The attributes' descriptors and values by vertex id; the table that
+  // starts the body has the root vertex's.
+  std::vector<VertexAttribute> attributes;
+  std::optional<AttributeCoder> attributeCoder;
+  bool attributeTableRead = false;
   SimplexStore store;
   std::optional<VertexSplitter> splitter;
   std::optional<PositionPredictor> predictor;
@@ -92,7 +101,7 @@ struct Decoder::State {
   explicit State(const DecoderOptions& o) : options(o) {}
 
   bool complete() const {
-    return hasHeader && level >= schedule->levels && (!connectivity || cells.empty());
+    return hasHeader && attributeTableRead && level >= schedule->levels && (!named || cells.empty());
   }
 
   Status fail(Status status) {
@@ -105,6 +114,8 @@ struct Decoder::State {
     schedule.emplace(header);
     dequantizer.emplace(header);
     connectivity = header.maxDimension > 0;
+    named = connectivity || header.attributeCount > 0;
+    attributeTableRead = header.attributeCount == 0;
     counts.emplace(schedule->levels, connectivity);
     coder.setMeasuring(options.measureCost);
     const Cell root{{0, 0, 0}, header.vertexCount, 0, 0, 0};
@@ -156,7 +167,9 @@ struct Decoder::State {
     }
     if (coder.invalid())
       return Status::error(ErrorCode::CorruptChunk, where + ": undecodable data");
-    cost.geometryBits = coder.cost() - cost.connectivityBits;
+    double attributeBits = 0;
+    for (const double bits : cost.attributeBits) attributeBits += bits;
+    cost.geometryBits = coder.cost() - cost.connectivityBits - attributeBits;
     if (complete() && connectivity) return checkFinalCounts();
     return Status::success();
   }
@@ -191,17 +204,20 @@ struct Decoder::State {
     const int axis = geometric ? schedule->axis[size_t(level)] : 0;
     if (geometric) child.prefix[axis] = cell.prefix[axis] << 1;
     uint32_t added = cell.vertex;
-    if (connectivity && !oneSided) {
+    if (named && !oneSided) {
       added = nextVertex++;
+      parents.push_back(cell.vertex);
+    }
+    if (connectivity && !oneSided) {
       if (added >= store.vertexCapacity())
         store.growVertices(std::min<uint32_t>(header.vertexCount, 2 * store.vertexCapacity()));
-      parents.push_back(cell.vertex);
       const double before = coder.cost();
       if (!splitter->split(coder, cell.vertex, added, level, splitBalance(population, firstHalf, geometric),
                            [] { return uint8_t(0); }))
         return false;
       cost.connectivityBits += coder.cost() - before;
     }
+    if (named && !oneSided) decodeAttributes(cell.vertex, added);
     for (const uint32_t half : {firstHalf, population - firstHalf}) {
       if (half == 1) {
         child.population = 1;
@@ -217,6 +233,20 @@ struct Decoder::State {
       child.vertex = added;
     }
     return true;
+  }
+
+  // The values of a new vertex, against its parent's.
+  void decodeAttributes(uint32_t parent, uint32_t vertex) {
+    for (size_t a = 0; a < attributes.size(); ++a) {
+      std::vector<uint8_t>& values = attributes[a].values;
+      const size_t bytes = attributes[a].valueBytes();
+      if (values.size() < (size_t(vertex) + 1) * bytes)
+        values.resize(std::min<size_t>(header.vertexCount, std::max<size_t>(vertex + 1, 2 * values.size() / bytes)) *
+                      bytes);
+      const double before = coder.cost();
+      attributeCoder->code(coder, a, values.data() + size_t(parent) * bytes, values.data() + size_t(vertex) * bytes);
+      cost.attributeBits[a] += coder.cost() - before;
+    }
   }
 
   void refineSingles(size_t begin, size_t end) {
@@ -434,6 +464,19 @@ struct Decoder::State {
     out.positions.clear();
     if (!hasHeader) return;
     const bool finished = complete();
+    // Attributes: the descriptors, then values vertex by vertex in the
+    // snapshot's order (by id with connectivity, else by cell).
+    out.attributes.resize(attributes.size());
+    for (size_t a = 0; a < attributes.size(); ++a) {
+      out.attributes[a].name = attributes[a].name;
+      out.attributes[a].type = attributes[a].type;
+      out.attributes[a].components = attributes[a].components;
+      out.attributes[a].values.clear();
+      if (connectivity) {
+        const uint8_t* values = attributes[a].values.data();
+        out.attributes[a].values.assign(values, values + size_t(nextVertex) * attributes[a].valueBytes());
+      }
+    }
     if (connectivity) {
       if (!finished && options.coarsePlacement == CoarsePlacement::Predicted) {
         placeOnNeighbourPlanes(out.positions);
@@ -466,9 +509,15 @@ struct Decoder::State {
         cellRange(cell, cellLevel, a, lo, hi);
         position[a] = dequantizer->position(a, lo, hi);
       }
-      // A finished cell holds coincident vertices; before that it is one vertex.
+      // A finished cell holds coincident vertices; before that it is one
+      // vertex. (With attributes, coincident vertices have cells of their own.)
       const uint32_t copies = finished ? cell.population : 1;
       for (uint32_t i = 0; i < copies; ++i) out.positions.insert(out.positions.end(), position, position + 3);
+      for (size_t a = 0; a < attributes.size(); ++a) {
+        const size_t bytes = attributes[a].valueBytes();
+        const uint8_t* values = attributes[a].values.data() + size_t(cell.vertex) * bytes;
+        out.attributes[a].values.insert(out.attributes[a].values.end(), values, values + bytes);
+      }
     });
     const uint32_t n = uint32_t(out.vertexCount());
     out.points.resize(n);
@@ -492,6 +541,21 @@ struct Decoder::State {
         if (status.ok()) status = startBody(available);
         offset += headerBytes;
         bytesConsumed += headerBytes;
+        continue;
+      }
+      if (!attributeTableRead) {
+        size_t tableBytes = 0;
+        const Parsed read = readAttributeTable(at, available, header.attributeCount, attributes, tableBytes, status);
+        if (read == Parsed::Incomplete) break;
+        if (read == Parsed::Malformed) break;
+        attributeCoder.emplace(attributes);
+        cost.attributeBits.assign(attributes.size(), 0.0);
+        attributeTableRead = true;
+        offset += tableBytes;
+        bytesConsumed += tableBytes;
+        if (header.chunkCount == 0 && bytesConsumed != header.totalBytes())
+          status = Status::error(ErrorCode::CorruptHeader, "corrupt attribute table: the header announced " +
+                                                               std::to_string(header.totalBytes()) + " bytes");
         continue;
       }
       if (chunks.size() == header.chunkCount) {

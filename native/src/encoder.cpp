@@ -4,6 +4,7 @@
 #include <cstring>
 #include <string>
 
+#include "attributes.h"
 #include "container.h"
 #include "count_coder.h"
 #include "decimation.h"
@@ -38,7 +39,7 @@ Status checkOptions(const Complex& complex, const EncodeOptions& options) {
     return Status::error(ErrorCode::InvalidInput, "the input has no vertices");
   if (complex.vertexCount() >= (size_t(1) << 31))
     return Status::error(ErrorCode::InvalidInput, "more than 2^31 - 1 vertices");
-  return Status::success();
+  return checkAttributes(complex);
 }
 
 // Writes chunks into the stream body: a frame, then the payload that the
@@ -110,8 +111,9 @@ class ChunkWriter {
 // that coincident vertices get their own ids.
 //
 // The visitor sees cell(level, geometric, population, firstHalf,
-// parentOneSided, keptId, addedId) for cells of several vertices (addedId is
-// kNoSimplex for a one-sided split), placed(id, prefix, level) for each
+// parentOneSided, keptId, addedId, firstKey) for cells of several vertices
+// (addedId is kNoSimplex for a one-sided split; the cell holds the keys from
+// index firstKey on), placed(id, prefix, level) for each
 // non-empty half of a geometric split, single(level, parentOneSided,
 // inFirstHalf, id) for one-vertex cells, named(keyIndex, id) when a vertex
 // gets its final id, splitDone() after each split, and levelDone(level,
@@ -157,7 +159,7 @@ void traverseKdTree(const std::vector<KdKey>& keys, const SplitSchedule& schedul
       const uint32_t firstHalf = split - cell.begin;
       const bool oneSided = firstHalf == 0 || firstHalf == population;
       const uint32_t addedId = oneSided ? kNoSimplex : nextId++;
-      visitor.cell(level, geometric, population, firstHalf, cell.parentOneSided, cell.id, addedId);
+      visitor.cell(level, geometric, population, firstHalf, cell.parentOneSided, cell.id, addedId, cell.begin);
       Cell halves[2] = {{cell.begin, split, cell.id, oneSided, {cell.prefix[0], cell.prefix[1], cell.prefix[2]}},
                         {split, cell.end, oneSided ? cell.id : addedId, oneSided,
                          {cell.prefix[0], cell.prefix[1], cell.prefix[2]}}};
@@ -248,6 +250,8 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
   // of the split order.
   SplitRecords records;
   bool connectivity = complex.hasSimplices();
+  // Vertices with attributes need ids, and coincident ones ids of their own.
+  const bool named = !complex.attributes.empty();
   if (connectivity) {
     report("connectivity", 0);
     std::vector<uint32_t> ids(header.vertexCount);
@@ -256,7 +260,7 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
       std::vector<uint32_t>& ids;
       std::vector<VertexSplitIds>& splits;
       const std::vector<uint32_t>& vertexOfKey;
-      void cell(int, bool, uint32_t, uint32_t, bool, uint32_t kept, uint32_t added) {
+      void cell(int, bool, uint32_t, uint32_t, bool, uint32_t kept, uint32_t added, uint32_t) {
         if (added != kNoSimplex) splits.push_back({kept, added});
       }
       void placed(uint32_t, const uint32_t*, int) {}
@@ -279,8 +283,13 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
   }
   if (!connectivity) header.simplexCounts[0] = header.vertexCount;
 
-  // Coarse to fine: the counts and, after each vertex split, its codes.
+  // Coarse to fine: the counts and, after each vertex split, its codes and
+  // its new vertex's attributes. The attribute table comes first.
   std::vector<uint8_t> body;
+  header.attributeCount = uint8_t(complex.attributes.size());
+  if (named) writeAttributeTable(complex.attributes, order.vertices[0], body);
+  AttributeCoder attributeCoder(complex.attributes);
+  result.cost.attributeBits.assign(complex.attributes.size(), 0.0);
   ChunkWriter chunks(body, options.chunkBytes);
   RangeEncoder& coder = chunks.coder();
   CountCoder counts(schedule.levels, connectivity);
@@ -305,11 +314,15 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
     bool connectivity;
     std::function<void(const char*, double)> report;
     std::vector<LevelCost>& levels;
+    const std::vector<VertexAttribute>& attributes;
+    const std::vector<uint32_t>& vertexOfKey;
+    AttributeCoder& attributeCoder;
+    std::vector<double>& attributeBits;
     int reportedLevel = -1;
     LevelCostTally levelCosts{};
 
     void cell(int level, bool geometric, uint32_t population, uint32_t firstHalf,
-              bool parentOneSided, uint32_t kept, uint32_t added) {
+              bool parentOneSided, uint32_t kept, uint32_t added, uint32_t firstKey) {
       if (level != reportedLevel) {
         reportedLevel = level;
         report("code", double(level) / double(schedule.levels + 1));
@@ -323,6 +336,19 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
                        RecordReader{&records.bytes[records.begin[splitIndex]]});
         ++splitIndex;
         connectivityBits += coder.cost() - before;
+      }
+      // The second half's vertex: the values of its first input vertex,
+      // against those of the cell's first.
+      if (added != kNoSimplex && !attributes.empty()) {
+        const uint32_t parent = vertexOfKey[firstKey], child = vertexOfKey[firstKey + firstHalf];
+        for (size_t a = 0; a < attributes.size(); ++a) {
+          const size_t bytes = attributes[a].valueBytes();
+          uint8_t values[16];
+          std::memcpy(values, attributes[a].values.data() + size_t(child) * bytes, bytes);
+          const double before = coder.cost();
+          attributeCoder.code(coder, a, attributes[a].values.data() + size_t(parent) * bytes, values);
+          attributeBits[a] += coder.cost() - before;
+        }
       }
     }
     void placed(uint32_t id, const uint32_t* prefix, int level) {
@@ -339,13 +365,17 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
     void levelDone(int level, uint32_t cells) {
       levelCosts.close(schedule, level, cells, coder.cost(), connectivityBits, levels);
     }
-  } coding{header, schedule, counts, coder, chunks, splitter, forward, predictor, records, splitIndex,
-           connectivityBits, connectivity, report, result.cost.levels};
-  traverseKdTree(order.keys, schedule, connectivity, coding);
+  } coding{header,      schedule,          counts,     coder,       chunks,     splitter,
+           forward,     predictor,         records,    splitIndex,  connectivityBits, connectivity,
+           report,      result.cost.levels, complex.attributes, order.vertices, attributeCoder,
+           result.cost.attributeBits};
+  traverseKdTree(order.keys, schedule, connectivity || named, coding);
   header.chunkCount = chunks.finish();
   header.bodyBytes = body.size();
   result.cost.connectivityBits = connectivityBits;
-  result.cost.geometryBits = coder.cost() - connectivityBits;
+  double attributeBits = 0;
+  for (const double bits : result.cost.attributeBits) attributeBits += bits;
+  result.cost.geometryBits = coder.cost() - connectivityBits - attributeBits;
   result.statistics = splitter.statistics();
   if (finalModels && connectivity) exportModels(predictor, counts, splitter, *finalModels);
 

@@ -31,12 +31,36 @@ namespace kdmesh {
 // tetrahedron is an isolated point of the complex whether or not it is listed
 // in `points`: readers fill `points` with what a file declares (OBJ `p`), the
 // encoder ignores it, and the decoder lists there every isolated vertex.
+// A per-vertex attribute: `components` values of one type for every
+// vertex, vertex after vertex (colours, normals, texture coordinates,
+// intensities, ...). The codec keeps them bit-exact: every prefix of a
+// stream gives each of its vertices the values of the input vertex it
+// stands for (see docs/FORMAT.md).
+enum class AttributeType : uint8_t { UInt8, Int8, UInt16, Int16, UInt32, Int32, Float32 };
+constexpr int kAttributeTypeCount = 7;
+// Bytes per value (1, 2 or 4) and the type's name ("uint8", "float32", ...).
+size_t attributeTypeBytes(AttributeType type);
+const char* attributeTypeName(AttributeType type);
+
+struct VertexAttribute {
+  std::string name;          // 1..64 printable ASCII characters, unique in a complex
+  AttributeType type = AttributeType::Float32;
+  uint8_t components = 1;    // 1..4
+  std::vector<uint8_t> values;  // vertex count · components values, in memory order
+
+  size_t valueBytes() const { return attributeTypeBytes(type) * components; }  // per vertex
+};
+// A stream carries at most this many attributes.
+constexpr size_t kMaxAttributes = 15;
+constexpr size_t kMaxAttributeNameBytes = 64;
+
 struct Complex {
   std::vector<float> positions;  // xyz, 3 floats per vertex
   std::vector<uint32_t> points;
   std::vector<uint32_t> edges;
   std::vector<uint32_t> triangles;
   std::vector<uint32_t> tetrahedra;
+  std::vector<VertexAttribute> attributes;
 
   size_t vertexCount() const { return positions.size() / 3; }
   size_t simplexCount(int dimension) const;
@@ -104,6 +128,9 @@ struct Header {
   std::array<uint32_t, 3> floatImageMin{};  // Float32: see docs/FORMAT.md
   uint64_t bodyBytes = 0;           // bytes after the header
   uint32_t chunkCount = 0;
+  // Vertex attributes (up to kMaxAttributes): their names, types and the
+  // root vertex's values are in the attribute table that starts the body.
+  uint8_t attributeCount = 0;
 
   // Bits of integer coordinate per axis: the kd-tree refines axis a
   // axisBits(a) times.
@@ -157,6 +184,7 @@ struct LevelCost {
 struct CodingCost {
   double geometryBits = 0;
   double connectivityBits = 0;
+  std::vector<double> attributeBits;  // per vertex attribute, in the stream's order
   // The same by kd-tree level, coarse to fine: where the bits of a model go,
   // and so how many a coarser quantization or a prefix of the stream would
   // keep. The decoder lists the levels it has completed.
