@@ -245,13 +245,20 @@ int runDecode(const DecodeArgs& args) {
   const double seconds = secondsSince(start);
   kdmesh::io::WriteOptions writeOptions;
   writeOptions.asciiPly = args.asciiPly;
+  const kdmesh::io::Format outputFormat = kdmesh::io::formatFromPath(args.output);
+  std::string formatName = kdmesh::io::formatName(outputFormat);
+  for (char& c : formatName) c = char(std::toupper(static_cast<unsigned char>(c)));
   if (prefix) {
-    const std::string dropped = keepWhatTheFormatHolds(kdmesh::io::formatFromPath(args.output), complex);
-    if (!dropped.empty()) {
-      std::string format = kdmesh::io::formatName(kdmesh::io::formatFromPath(args.output));
-      for (char& c : format) c = char(std::toupper(static_cast<unsigned char>(c)));
-      note(args.output + ": left out " + dropped + " of the prefix, which " + format + " cannot hold");
-    }
+    const std::string dropped = keepWhatTheFormatHolds(outputFormat, complex);
+    if (!dropped.empty()) note(args.output + ": left out " + dropped + " of the prefix, which " + formatName + " cannot hold");
+  }
+  // Only PLY holds vertex attributes.
+  if (outputFormat != kdmesh::io::Format::Ply && outputFormat != kdmesh::io::Format::Unknown &&
+      !complex.attributes.empty()) {
+    std::string names;
+    for (const kdmesh::VertexAttribute& a : complex.attributes) names += (names.empty() ? "" : ", ") + oneLine(a.name);
+    note(args.output + ": left out the vertex attributes " + names + ", which " + formatName + " cannot hold");
+    complex.attributes.clear();
   }
   if (auto s = kdmesh::io::writeFile(args.output, complex, writeOptions); !s.ok())
     return fail(s, args.output);

@@ -299,6 +299,17 @@ Status readFile(const std::string& path, Complex& out, Notes& notes,
   return readMemory(format, bytes.data(), bytes.size(), out, notes, options);
 }
 
+// Only PLY holds vertex attributes: other formats refuse a complex with
+// them rather than drop them silently.
+Status checkAttributesWritable(Format format, const Complex& complex) {
+  if (format == Format::Ply || complex.attributes.empty()) return Status::success();
+  std::string names;
+  for (const VertexAttribute& a : complex.attributes) names += (names.empty() ? "" : ", ") + a.name;
+  return Status::error(ErrorCode::InvalidArgument, std::string(formatName(format)) +
+                                                       " cannot hold vertex attributes (" + names +
+                                                       "): write PLY to keep them");
+}
+
 Status writeMemory(Format format, const Complex& complex,
                    std::vector<uint8_t>& out, const WriteOptions& options) {
   out.clear();
@@ -310,6 +321,7 @@ Status writeMemory(Format format, const Complex& complex,
                          "writing STL is not supported");
   }
   if (Status status = checkWritable(complex); !status.ok()) return status;
+  if (Status status = checkAttributesWritable(format, complex); !status.ok()) return status;
   Status status;
   switch (format) {
     case Format::Ply: status = detail::writePly(complex, out, options); break;
@@ -338,7 +350,10 @@ Status writeFile(const std::string& path, const Complex& complex,
                  const WriteOptions& options) {
   const Format format = formatFromPath(path);
   if (format == Format::Unknown) return unknownFormat(path);
-  if (format == Format::TetGen) return writeTetgenFiles(path, complex);
+  if (format == Format::TetGen) {
+    if (Status status = checkAttributesWritable(format, complex); !status.ok()) return status;
+    return writeTetgenFiles(path, complex);
+  }
   std::vector<uint8_t> bytes;
   if (Status status = writeMemory(format, complex, bytes, options);
       !status.ok()) {

@@ -240,7 +240,7 @@ Status parseHeader(TextScanner& scanner, PlyHeader& header) {
 // ---------------------------------------------------------------------------
 
 enum class Role : uint8_t { Vertex, Face, Edge, Tetra, Other };
-enum class Use : uint8_t { Skip, X, Y, Z, First, Second, List };
+enum class Use : uint8_t { Skip, X, Y, Z, First, Second, List, Attribute };
 
 bool isIndexUse(Use use) {
   return use == Use::First || use == Use::Second || use == Use::List;
@@ -286,14 +286,126 @@ Use useOf(Role role, const PlyProperty& property) {
   return Use::Skip;
 }
 
+// Where a vertex property's value goes: attribute `index`, `component`.
+struct AttributeSlot {
+  uint8_t index = 0, component = 0;
+};
+
 struct ElementPlan {
   Role role = Role::Other;
   std::vector<Use> uses;  // one per property
+  std::vector<AttributeSlot> slots;  // one per property (Use::Attribute)
+  // Vertex attributes: names, types and components (values empty).
+  std::vector<VertexAttribute> attributes;
   // Allowed lengths of the index list: faces are polygons, tetrahedra have
   // exactly four vertices.
   uint64_t listMin = 0;
   uint64_t listMax = 0;
 };
+
+// The PLY scalar types an attribute keeps bit for bit.
+bool attributeTypeOf(Scalar scalar, AttributeType& type) {
+  switch (scalar) {
+    case Scalar::Int8: type = AttributeType::Int8; return true;
+    case Scalar::UInt8: type = AttributeType::UInt8; return true;
+    case Scalar::Int16: type = AttributeType::Int16; return true;
+    case Scalar::UInt16: type = AttributeType::UInt16; return true;
+    case Scalar::Int32: type = AttributeType::Int32; return true;
+    case Scalar::UInt32: type = AttributeType::UInt32; return true;
+    case Scalar::Float32: type = AttributeType::Float32; return true;
+    case Scalar::Float64: return false;
+  }
+  return false;
+}
+
+// Vertex properties read as one attribute of several components, by the
+// names PLY files commonly give them; a group needs its first `required`
+// properties, of one type. Properties name_0, name_1, ... (as the writer
+// names an attribute's components) also form one attribute.
+struct AttributeGroup {
+  std::string_view attribute;
+  std::array<std::string_view, 4> properties;
+  size_t required;
+};
+constexpr AttributeGroup kAttributeGroups[] = {
+    {"color", {"red", "green", "blue", "alpha"}, 3},
+    {"color", {"r", "g", "b", "a"}, 3},
+    {"normal", {"nx", "ny", "nz", ""}, 3},
+    {"uv", {"u", "v", "", ""}, 2},
+    {"uv", {"s", "t", "", ""}, 2},
+    {"uv", {"texture_u", "texture_v", "", ""}, 2},
+};
+
+// Plans the vertex properties besides x, y, z as attributes; `skipped`
+// gets those no attribute can hold.
+void planAttributes(const PlyElement& element, ElementPlan& plan, std::string& skipped) {
+  const std::vector<PlyProperty>& properties = element.properties;
+  auto candidate = [&](size_t i) {
+    AttributeType type;
+    return plan.uses[i] == Use::Skip && !properties[i].isList && attributeTypeOf(properties[i].type, type) &&
+           properties[i].name.size() <= kMaxAttributeNameBytes;
+  };
+  auto find = [&](std::string_view name) {
+    for (size_t i = 0; i < properties.size(); ++i)
+      if (candidate(i) && properties[i].name == name) return i;
+    return properties.size();
+  };
+  // The attributes found, each with its properties; in the file's order of
+  // their first properties.
+  std::vector<std::pair<std::string, std::vector<size_t>>> found;
+  std::vector<bool> taken(properties.size(), false);
+  auto take = [&](std::string name, const std::vector<size_t>& members) {
+    for (const size_t i : members) taken[i] = true;
+    found.emplace_back(std::move(name), members);
+  };
+  auto free = [&](std::string_view name) {
+    const size_t i = find(name);
+    return i < properties.size() && !taken[i] ? i : properties.size();
+  };
+  for (const AttributeGroup& group : kAttributeGroups) {
+    std::vector<size_t> members;
+    for (const std::string_view name : group.properties) {
+      if (name.empty()) break;
+      const size_t i = free(name);
+      if (i == properties.size() || (!members.empty() && properties[i].type != properties[members[0]].type)) break;
+      members.push_back(i);
+    }
+    if (members.size() >= group.required) take(std::string(group.attribute), members);
+  }
+  for (size_t i = 0; i < properties.size(); ++i) {
+    if (!candidate(i) || taken[i]) continue;
+    const std::string& name = properties[i].name;
+    std::vector<size_t> members{i};
+    if (name.size() > 2 && name.compare(name.size() - 2, 2, "_0") == 0) {
+      const std::string base = name.substr(0, name.size() - 2);
+      for (size_t k = 1; k < 4; ++k) {
+        const size_t j = free(base + "_" + std::to_string(k));
+        if (j == properties.size() || properties[j].type != properties[i].type) break;
+        members.push_back(j);
+      }
+      if (members.size() > 1) {
+        take(base, members);
+        continue;
+      }
+    }
+    take(name, members);
+  }
+  std::stable_sort(found.begin(), found.end(), [](const auto& a, const auto& b) { return a.second[0] < b.second[0]; });
+  for (const auto& [name, members] : found) {
+    if (plan.attributes.size() == kMaxAttributes) break;
+    VertexAttribute a;
+    a.name = name;
+    attributeTypeOf(properties[members[0]].type, a.type);
+    a.components = uint8_t(members.size());
+    for (size_t k = 0; k < members.size(); ++k) {
+      plan.uses[members[k]] = Use::Attribute;
+      plan.slots[members[k]] = {uint8_t(plan.attributes.size()), uint8_t(k)};
+    }
+    plan.attributes.push_back(std::move(a));
+  }
+  for (size_t i = 0; i < properties.size(); ++i)
+    if (plan.uses[i] == Use::Skip) skipped += " " + properties[i].name;
+}
 
 Status planElement(const PlyElement& element, ElementPlan& plan,
                    bool& doubleCoordinates, Notes& notes) {
@@ -315,8 +427,14 @@ Status planElement(const PlyElement& element, ElementPlan& plan,
     if (use != Use::Skip && property.type == Scalar::Float64) {
       doubleCoordinates = true;
     }
-    if (use == Use::Skip) skipped += " " + property.name;
     plan.uses.push_back(use);
+  }
+  plan.slots.resize(plan.uses.size());
+  if (plan.role == Role::Vertex) {
+    planAttributes(element, plan, skipped);
+  } else {
+    for (size_t i = 0; i < plan.uses.size(); ++i)
+      if (plan.uses[i] == Use::Skip) skipped += " " + element.properties[i].name;
   }
   for (const Slot& slot : kSlots) {
     if (slot.role == plan.role &&
@@ -364,6 +482,25 @@ class AsciiValues {
     for (uint64_t i = 0; i < count; ++i) {
       if (!next(token)) return false;
     }
+    return true;
+  }
+  // One attribute value of `type` into `out`, in memory order.
+  bool attribute(Scalar type, uint8_t* out) {
+    if (type == Scalar::Float32) {
+      float value;
+      if (!coordinate(type, value)) return false;
+      std::memcpy(out, &value, 4);
+      return true;
+    }
+    int64_t value;
+    if (!integer(type, value)) return false;
+    const int bits = int(8 * scalarBytes(type));
+    const bool isSigned = type == Scalar::Int8 || type == Scalar::Int16 || type == Scalar::Int32;
+    const int64_t low = isSigned ? -(int64_t(1) << (bits - 1)) : 0;
+    const int64_t high = isSigned ? (int64_t(1) << (bits - 1)) - 1 : (int64_t(1) << bits) - 1;
+    if (value < low || value > high) return fail(std::to_string(value) + " is out of the property's range");
+    const uint32_t bitsOfValue = uint32_t(uint64_t(value));
+    std::memcpy(out, &bitsOfValue, scalarBytes(type));  // little-endian, as the codec's values
     return true;
   }
   // A value takes at least a digit and a separator.
@@ -416,6 +553,15 @@ class BinaryValues {
   bool skip(Scalar type, uint64_t count) {
     if (!canHold(count, type)) return fail(kTruncated);
     cursor_ += count * scalarBytes(type);
+    return true;
+  }
+  // One attribute value of `type` into `out`, in memory order
+  // (little-endian).
+  bool attribute(Scalar type, uint8_t* out) {
+    if (!available(type)) return false;
+    const size_t bytes = scalarBytes(type);
+    for (size_t i = 0; i < bytes; ++i) out[i] = data_[cursor_ + (bigEndian_ ? bytes - 1 - i : i)];
+    cursor_ += bytes;
     return true;
   }
   static uint64_t minBytes(Scalar type) { return scalarBytes(type); }
@@ -541,6 +687,8 @@ Status readElement(Values& values, const PlyElement& element,
   // their count: do not spend a step on each of up to 2^64 of them.
   if (element.properties.empty()) return Status::success();
   Complex& out = state.out;
+  // One vertex's attribute values, component by component.
+  std::vector<std::array<uint8_t, 16>> vertexValues(plan.attributes.size());
   for (uint64_t item = 0; item < element.count; ++item) {
     float xyz[3] = {0, 0, 0};
     uint32_t pair[2] = {0, 0};
@@ -561,6 +709,12 @@ Status readElement(Values& values, const PlyElement& element,
         case Use::List:
           ok = readIndexList(values, property, plan, state);
           break;
+        case Use::Attribute: {
+          const AttributeSlot slot = plan.slots[i];
+          ok = values.attribute(property.type,
+                                vertexValues[slot.index].data() + slot.component * scalarBytes(property.type));
+          break;
+        }
         case Use::Skip:
           ok = skipProperty(values, property);
           break;
@@ -574,6 +728,10 @@ Status readElement(Values& values, const PlyElement& element,
     switch (plan.role) {
       case Role::Vertex:
         out.positions.insert(out.positions.end(), xyz, xyz + 3);
+        for (size_t a = 0; a < vertexValues.size(); ++a) {
+          std::vector<uint8_t>& values = out.attributes[a].values;
+          values.insert(values.end(), vertexValues[a].data(), vertexValues[a].data() + out.attributes[a].valueBytes());
+        }
         break;
       case Role::Face:
         state.split.append(polygon.data(), polygon.size(), out.triangles);
@@ -657,6 +815,8 @@ Status readPly(const uint8_t* data, size_t size, Complex& out, Notes& notes) {
       !status.ok()) {
     return status;
   }
+  for (const ElementPlan& plan : plans)
+    if (plan.role == Role::Vertex) out.attributes = plan.attributes;
   BodyState state{out, vertexCount, {}, {}};
   Status status;
   uint64_t trailingBytes = 0;
@@ -696,10 +856,45 @@ struct SimplexElement {
   bool isList;
 };
 
+// The PLY names of an attribute's components: the names the reader groups
+// (red green blue alpha, nx ny nz, u v), else the attribute's name, with _0,
+// _1, ... for several components.
+std::vector<std::string> propertyNames(const VertexAttribute& a) {
+  static constexpr std::string_view kColour[4] = {"red", "green", "blue", "alpha"};
+  static constexpr std::string_view kNormal[3] = {"nx", "ny", "nz"};
+  static constexpr std::string_view kUv[2] = {"u", "v"};
+  std::vector<std::string> names;
+  for (int k = 0; k < a.components; ++k) {
+    if (a.name == "color" && a.components >= 3) names.emplace_back(kColour[k]);
+    else if (a.name == "normal" && a.components == 3) names.emplace_back(kNormal[k]);
+    else if (a.name == "uv" && a.components == 2) names.emplace_back(kUv[k]);
+    else if (a.components == 1) names.push_back(a.name);
+    else names.push_back(a.name + "_" + std::to_string(k));
+  }
+  return names;
+}
+
+const char* plyTypeName(AttributeType type) {
+  switch (type) {
+    case AttributeType::UInt8: return "uchar";
+    case AttributeType::Int8: return "char";
+    case AttributeType::UInt16: return "ushort";
+    case AttributeType::Int16: return "short";
+    case AttributeType::UInt32: return "uint";
+    case AttributeType::Int32: return "int";
+    case AttributeType::Float32: return "float";
+  }
+  return "float";
+}
+
 class BinarySink {
  public:
   explicit BinarySink(std::vector<uint8_t>& out) : out_(out) {}
   void coordinate(float value) { appendLittleEndian(out_, value); }
+  // One attribute value, from its bytes in memory order (little-endian).
+  void attribute(AttributeType type, const uint8_t* value) {
+    out_.insert(out_.end(), value, value + attributeTypeBytes(type));
+  }
   void listLength(uint8_t length) { out_.push_back(length); }
   void index(uint32_t value) { appendLittleEndian(out_, value); }
   void endItem() {}
@@ -712,6 +907,22 @@ class TextSink {
  public:
   explicit TextSink(std::vector<uint8_t>& out) : text_(out) {}
   void coordinate(float value) { text_.real(value); }
+  void attribute(AttributeType type, const uint8_t* value) {
+    uint32_t bits = 0;
+    std::memcpy(&bits, value, attributeTypeBytes(type));
+    switch (type) {
+      case AttributeType::Float32: {
+        float f;
+        std::memcpy(&f, &bits, 4);
+        text_.real(f);
+        break;
+      }
+      case AttributeType::Int8: text_.word(std::to_string(int8_t(bits))); break;
+      case AttributeType::Int16: text_.word(std::to_string(int16_t(bits))); break;
+      case AttributeType::Int32: text_.word(std::to_string(int32_t(bits))); break;
+      default: text_.integer(bits); break;
+    }
+  }
   void listLength(uint8_t length) { text_.integer(length); }
   void index(uint32_t value) { text_.integer(value); }
   void endItem() { text_.endLine(); }
@@ -726,6 +937,10 @@ void writeBody(const Complex& complex,
   for (size_t v = 0; v < complex.vertexCount(); ++v) {
     for (int axis = 0; axis < 3; ++axis) {
       sink.coordinate(complex.positions[3 * v + axis]);
+    }
+    for (const VertexAttribute& a : complex.attributes) {
+      const size_t bytes = attributeTypeBytes(a.type);
+      for (size_t k = 0; k < a.components; ++k) sink.attribute(a.type, &a.values[(v * a.components + k) * bytes]);
     }
     sink.endItem();
   }
@@ -754,6 +969,8 @@ void writeHeader(const Complex& complex,
   for (const char* axis : {"x", "y", "z"}) {
     text.word("property float").word(axis).endLine();
   }
+  for (const VertexAttribute& a : complex.attributes)
+    for (const std::string& name : propertyNames(a)) text.word("property").word(plyTypeName(a.type)).word(name).endLine();
   for (const SimplexElement& element : elements) {
     text.word("element")
         .word(element.name)
