@@ -333,12 +333,18 @@ TEST(IoPly, ReadsAsciiWithDoublesExtraPropertiesAndCrlf) {
                                        FLT_MAX, -1.5f, 0.0f,  0.0f,  1.0f, 1.0f, 1.0f};
   EXPECT_EQ(bitsOf(r.complex.positions), bitsOf(expected));
   EXPECT_EQ(r.complex.triangles, (std::vector<uint32_t>{0, 1, 2, 0, 1, 2, 0, 2, 3}));
-  EXPECT_TRUE(r.hasNote("red")) << joined(r.notes);
-  EXPECT_TRUE(r.hasNote("nx")) << joined(r.notes);
+  // Vertex properties besides the coordinates are kept as attributes.
+  ASSERT_EQ(r.complex.attributes.size(), 2u);
+  EXPECT_EQ(r.complex.attributes[0].name, "red");
+  EXPECT_EQ(r.complex.attributes[0].values, (std::vector<uint8_t>{255, 0, 0, 1}));
+  EXPECT_EQ(r.complex.attributes[1].name, "nx");
+  EXPECT_EQ(r.complex.attributes[1].type, AttributeType::Float32);
+  EXPECT_EQ(r.complex.attributes[1].values.size(), 16u);
+  EXPECT_FALSE(r.hasNote("vertex properties")) << joined(r.notes);
   EXPECT_TRUE(r.hasNote("flags")) << joined(r.notes);
   EXPECT_TRUE(r.hasNote("double")) << joined(r.notes);
   EXPECT_TRUE(r.hasNote("split 1 polygons")) << joined(r.notes);
-  EXPECT_EQ(r.notes.size(), 4u) << joined(r.notes);
+  EXPECT_EQ(r.notes.size(), 3u) << joined(r.notes);
 
   // Values after the declared elements are noted, not dropped silently.
   const ReadResult extra = readText(Format::Ply, text + "3 3 2 1 0\n\n");
@@ -411,7 +417,11 @@ TEST(IoPly, ReadsBinaryInBothByteOrdersWithFloatOrDoubleCoordinates) {
         EXPECT_EQ(bitsOf(r.complex.positions[3]), bitsOf(1.0f));  // tie to even
         EXPECT_EQ(r.complex.triangles,
                   (std::vector<uint32_t>{2, 1, 0, 0, 1, 2, 0, 2, 3, 0, 3, 1}));
-        EXPECT_TRUE(r.hasNote("ignored vertex properties: red uv quality")) << joined(r.notes);
+        // red is kept as an attribute; a list (uv) and a double (quality) are not.
+        EXPECT_TRUE(r.hasNote("ignored vertex properties: uv quality")) << joined(r.notes);
+        ASSERT_EQ(r.complex.attributes.size(), 1u);
+        EXPECT_EQ(r.complex.attributes[0].name, "red");
+        EXPECT_EQ(r.complex.attributes[0].values, std::vector<uint8_t>(4, 200));
         EXPECT_TRUE(r.hasNote("material")) << joined(r.notes);
         EXPECT_TRUE(r.hasNote("split 1 polygons")) << joined(r.notes);
         EXPECT_EQ(r.hasNote("double"), doubles) << joined(r.notes);
