@@ -8,7 +8,7 @@
 // With several runs, one row per run and a summary: long tasks are rare
 // events, and one clean run says little.
 import { execFileSync } from 'node:child_process';
-import { mkdtempSync } from 'node:fs';
+import { mkdtempSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { launchChromium } from '../tests/browser/chromium.mjs';
@@ -22,6 +22,7 @@ function option(name, fallback) {
 const throttle = option('--throttle', 10000);
 const runs = option('--runs', 1);
 const models = mkdtempSync(join(tmpdir(), 'kdmesh-browser-bench-'));
+process.on('exit', () => rmSync(models, { recursive: true, force: true }));
 const dragon = join(root, 'build', 'models', 'dragon_vrip.ply');
 // The CLI that bench/run.sh builds alongside the WebAssembly decoder it
 // rebuilds: build/'s may be older, and its streams of another format version.

@@ -9,7 +9,7 @@
 // Writes DIR/dragon-BYTES-predicted.jpg and DIR/dragon-BYTES-centre.jpg
 // (DIR: build-bench/coarse-levels; 640 × 480, JPEG quality 85).
 import { execFileSync } from 'node:child_process';
-import { mkdirSync, mkdtempSync, readFileSync, writeFileSync } from 'node:fs';
+import { mkdirSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { launchChromium } from '../tests/browser/chromium.mjs';
@@ -23,6 +23,7 @@ const prefixes = args.length ? args.map(Number) : [8000, 16000, 50000];
 mkdirSync(out, { recursive: true });
 
 const models = mkdtempSync(join(tmpdir(), 'kdmesh-coarse-levels-'));
+process.on('exit', () => rmSync(models, { recursive: true, force: true }));
 const stream = join(models, 'dragon.kdm');
 execFileSync(join(root, 'build', 'kdmesh'),
              ['encode', join(root, 'build', 'models', 'dragon_vrip.ply'), '-o', stream, '--bits', '12', '-q']);

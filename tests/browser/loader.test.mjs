@@ -6,7 +6,7 @@
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
-import { mkdtempSync, readFileSync } from 'node:fs';
+import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { launchChromium } from './chromium.mjs';
@@ -40,6 +40,7 @@ before(async () => {
 after(async () => {
   await browser?.close();
   server?.close();
+  rmSync(models, { recursive: true, force: true });
 });
 
 async function openPage() {

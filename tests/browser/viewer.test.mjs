@@ -3,7 +3,7 @@
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
-import { mkdtempSync, readFileSync, writeFileSync } from 'node:fs';
+import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { launchChromium } from './chromium.mjs';
@@ -36,6 +36,7 @@ before(async () => {
 after(async () => {
   await browser?.close();
   server?.close();
+  rmSync(models, { recursive: true, force: true });
 });
 
 async function openViewer(query, viewport = { width: 800, height: 600 }) {

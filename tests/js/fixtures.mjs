@@ -2,7 +2,7 @@
 // from complexes generated here, so that the WebAssembly decoder can be
 // compared with the native one on the same streams.
 import { execFileSync } from 'node:child_process';
-import { existsSync, mkdtempSync, readFileSync, writeFileSync } from 'node:fs';
+import { existsSync, mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join, dirname } from 'node:path';
 import { fileURLToPath } from 'node:url';
@@ -10,6 +10,7 @@ import { fileURLToPath } from 'node:url';
 export const root = join(dirname(fileURLToPath(import.meta.url)), '..', '..');
 export const cli = join(root, 'build', 'kdmesh');
 export const workDir = mkdtempSync(join(tmpdir(), 'kdmesh-js-'));
+process.on('exit', () => rmSync(workDir, { recursive: true, force: true }));
 
 function random(seed) {
   let state = seed >>> 0;
