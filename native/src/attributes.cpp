@@ -101,7 +101,7 @@ AttributeCoder::AttributeCoder(const std::vector<VertexAttribute>& attributes) {
     const int bytes = int(attributeTypeBytes(a.type));
     layouts_.push_back({a.type, a.components, bytes, 8 * bytes,
                         bytes == 4 ? 0xffffffffu : (uint32_t(1) << (8 * bytes)) - 1, models});
-    models += size_t(a.components) * kLengthClasses;
+    models += size_t(a.components) * kLengthClasses * kLengthClasses;
   }
   models_.resize(models);
 }

@@ -1,20 +1,22 @@
 // Vertex attributes in the stream: the table that starts the body, and the
-// coding of each new vertex's values against its parent's.
+// coding of each new vertex's values.
 //
 // Every vertex of a prefix stands for one input vertex, the one that keeps
 // its id down to the last level: the input vertex first in kd-tree order
 // among those of its cell. When a cell splits into two non-empty halves,
 // the first half keeps the vertex (and its values) and the second half's
-// new vertex gets the values of its own first input vertex, coded as the
-// difference from its parent's, component by component. A prefix therefore
-// shows every vertex with exact values, and the last level has every input
-// vertex's. Differences are taken modulo 2^(8 · bytes) on the values' bits
-// (float32 bits first mapped to integers in the order of their values, so
-// that close values have close images) and coded as: zero or not, sign,
-// bit length in unary, the two bits after the leading one with adaptive
-// models, the rest uniformly. The models of a component are chosen by the
-// bit length of the previous component's difference (colour channels, the
-// axes of a normal, move together).
+// new vertex gets the values of its own first input vertex. A prefix
+// therefore shows every vertex with exact values, and the last level has
+// every input vertex's. The new values are predicted by the mean of the new
+// vertex's neighbours in the complex (after its split), or by its parent's
+// without neighbours (point clouds), and coded component by component as
+// differences modulo 2^(8 · bytes) on the values' bits (float32 bits first
+// mapped to integers in the order of their values, so that close values
+// have close images): zero or not, sign, bit length in unary, the two bits
+// after the leading one with adaptive models, the rest uniformly. A
+// component's models are chosen by the bit length of the previous
+// component's difference (colour channels, the axes of a normal, move
+// together) and by how far the neighbours' values spread.
 #pragma once
 
 #include <algorithm>
@@ -48,18 +50,52 @@ class AttributeCoder {
  public:
   explicit AttributeCoder(const std::vector<VertexAttribute>& attributes);
 
+  // A new vertex's values of one attribute predicted: `values`, the
+  // rounded mean of its neighbours' (their images), or its parent's without
+  // neighbours; `spread`, per component, the bit length of the range of the
+  // neighbours' images (0 without neighbours), which says how far to trust
+  // the mean.
+  struct Prediction {
+    uint8_t values[16];
+    uint8_t spread[4];
+  };
+  // valuesOf(id) gives a vertex's values.
+  template <class ValuesOf>
+  void predict(size_t a, const std::vector<uint32_t>& neighbours, const uint8_t* parent, ValuesOf&& valuesOf,
+               Prediction& out) const {
+    const Layout& layout = layouts_[a];
+    if (neighbours.empty()) {
+      std::copy(parent, parent + layout.components * layout.bytes, out.values);
+      std::fill(out.spread, out.spread + 4, uint8_t(0));
+      return;
+    }
+    for (int c = 0; c < layout.components; ++c) {
+      uint64_t sum = 0;
+      uint32_t low = 0xffffffffu, high = 0;
+      for (const uint32_t v : neighbours) {
+        const uint32_t value = image(layout, valuesOf(v), c);
+        sum += value;
+        low = std::min(low, value);
+        high = std::max(high, value);
+      }
+      store(layout, out.values, c, uint32_t((sum + neighbours.size() / 2) / neighbours.size()));
+      out.spread[c] = uint8_t(bitLength(high - low));
+    }
+  }
+
   // Codes the values of one vertex of attribute `a` (encoder: `child`; the
-  // decoder writes them there) against its parent's.
+  // decoder writes them there) against `prediction`.
   template <class Coder>
-  void code(Coder& coder, size_t a, const uint8_t* parent, uint8_t* child) {
+  void code(Coder& coder, size_t a, const Prediction& prediction, uint8_t* child) {
     const Layout& layout = layouts_[a];
     int previousLength = 0;
     for (int c = 0; c < layout.components; ++c) {
-      const uint32_t from = image(layout, parent, c);
+      const uint32_t from = image(layout, prediction.values, c);
       const uint32_t to = image(layout, child, c);  // the encoder's value; ignored by the decoder
-      const uint32_t difference = codeDifference(coder, models_[layout.firstModels + size_t(c) * kLengthClasses +
-                                                               size_t(lengthClass(previousLength))],
-                                                 layout.bits, (to - from) & layout.mask, previousLength);
+      const size_t context = (size_t(c) * kLengthClasses + size_t(lengthClass(previousLength))) * kLengthClasses +
+                             size_t(lengthClass(prediction.spread[c]));
+      const uint32_t difference = codeDifference(coder, models_[layout.firstModels + context], layout.bits,
+                                                 (to - from) & layout.mask, previousLength);
       store(layout, child, c, (from + difference) & layout.mask);
     }
   }

@@ -82,6 +82,7 @@ struct Decoder::State {
   std::vector<VertexAttribute> attributes;
   std::optional<AttributeCoder> attributeCoder;
   bool attributeTableRead = false;
+  std::vector<uint32_t> neighbours;  // of the vertex whose attributes are decoded
   SimplexStore store;
   std::optional<VertexSplitter> splitter;
   std::optional<PositionPredictor> predictor;
@@ -235,16 +236,24 @@ struct Decoder::State {
     return true;
   }
 
-  // The values of a new vertex, against its parent's.
+  // The values of a new vertex, against its neighbours' (or its parent's).
   void decodeAttributes(uint32_t parent, uint32_t vertex) {
+    neighbours.clear();
+    if (connectivity)
+      store.forEachIncident(1, vertex, [&](uint32_t edge, uint32_t position) {
+        neighbours.push_back(store.vertices(1, edge)[1 - position]);
+      });
     for (size_t a = 0; a < attributes.size(); ++a) {
       std::vector<uint8_t>& values = attributes[a].values;
       const size_t bytes = attributes[a].valueBytes();
       if (values.size() < (size_t(vertex) + 1) * bytes)
         values.resize(std::min<size_t>(header.vertexCount, std::max<size_t>(vertex + 1, 2 * values.size() / bytes)) *
                       bytes);
+      AttributeCoder::Prediction prediction;
+      attributeCoder->predict(a, neighbours, values.data() + size_t(parent) * bytes,
+                              [&](uint32_t id) { return values.data() + size_t(id) * bytes; }, prediction);
       const double before = coder.cost();
-      attributeCoder->code(coder, a, values.data() + size_t(parent) * bytes, values.data() + size_t(vertex) * bytes);
+      attributeCoder->code(coder, a, prediction, values.data() + size_t(vertex) * bytes);
       cost.attributeBits[a] += coder.cost() - before;
     }
   }

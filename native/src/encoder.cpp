@@ -252,6 +252,7 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
   bool connectivity = complex.hasSimplices();
   // Vertices with attributes need ids, and coincident ones ids of their own.
   const bool named = !complex.attributes.empty();
+  std::vector<uint32_t> inputOfId;  // with connectivity and attributes
   if (connectivity) {
     report("connectivity", 0);
     std::vector<uint32_t> ids(header.vertexCount);
@@ -270,6 +271,10 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
       void levelDone(int, uint32_t) {}
     } naming{ids, splits, order.vertices};
     traverseKdTree(order.keys, schedule, true, naming);
+    if (named) {
+      inputOfId.resize(ids.size());
+      for (uint32_t input = 0; input < ids.size(); ++input) inputOfId[ids[input]] = input;
+    }
     SimplexStore store;
     InputSummary summary;
     if (result.status = buildInputComplex(complex, ids, store, summary); !result.status.ok())
@@ -318,6 +323,8 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
     const std::vector<uint32_t>& vertexOfKey;
     AttributeCoder& attributeCoder;
     std::vector<double>& attributeBits;
+    const std::vector<uint32_t>& inputOfId;  // connectivity streams
+    std::vector<uint32_t> neighbours{};
     int reportedLevel = -1;
     LevelCostTally levelCosts{};
 
@@ -341,12 +348,21 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
       // against those of the cell's first.
       if (added != kNoSimplex && !attributes.empty()) {
         const uint32_t parent = vertexOfKey[firstKey], child = vertexOfKey[firstKey + firstHalf];
+        neighbours.clear();
+        if (connectivity)
+          forward.forEachIncident(1, added, [&](uint32_t edge, uint32_t position) {
+            neighbours.push_back(forward.vertices(1, edge)[1 - position]);
+          });
         for (size_t a = 0; a < attributes.size(); ++a) {
+          const uint8_t* values = attributes[a].values.data();
           const size_t bytes = attributes[a].valueBytes();
-          uint8_t values[16];
-          std::memcpy(values, attributes[a].values.data() + size_t(child) * bytes, bytes);
+          AttributeCoder::Prediction prediction;
+          uint8_t coded[16];
+          attributeCoder.predict(a, neighbours, values + size_t(parent) * bytes,
+                                 [&](uint32_t id) { return values + size_t(inputOfId[id]) * bytes; }, prediction);
+          std::memcpy(coded, values + size_t(child) * bytes, bytes);
           const double before = coder.cost();
-          attributeCoder.code(coder, a, attributes[a].values.data() + size_t(parent) * bytes, values);
+          attributeCoder.code(coder, a, prediction, coded);
           attributeBits[a] += coder.cost() - before;
         }
       }
@@ -368,7 +384,7 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
   } coding{header,      schedule,          counts,     coder,       chunks,     splitter,
            forward,     predictor,         records,    splitIndex,  connectivityBits, connectivity,
            report,      result.cost.levels, complex.attributes, order.vertices, attributeCoder,
-           result.cost.attributeBits};
+           result.cost.attributeBits, inputOfId};
   traverseKdTree(order.keys, schedule, connectivity || named, coding);
   header.chunkCount = chunks.finish();
   header.bodyBytes = body.size();
