@@ -736,6 +736,25 @@ TEST(IoVtk, ReadsUnstructuredGridWithEveryCellKindCrlfAndIgnoredData) {
   }
 }
 
+// A cell type of its own in every cell: the note names a few types and
+// counts the rest, rather than growing with the file.
+TEST(IoVtk, ManySkippedCellTypesMakeAShortNote) {
+  std::string cells, types;
+  for (int c = 0; c < 1000; ++c) {
+    cells += "1 0\n";
+    types += std::to_string(100 + c) + "\n";
+  }
+  const ReadResult r = readText(Format::Vtk, "# vtk DataFile Version 3.0\nt\nASCII\n"
+                                             "DATASET UNSTRUCTURED_GRID\nPOINTS 1 float\n0 0 0\n"
+                                             "CELLS 1000 2000\n" + cells + "CELL_TYPES 1000\n" + types);
+  ASSERT_TRUE(r.status.ok()) << r.status.message;
+  ASSERT_EQ(r.notes.size(), 1u) << joined(r.notes);
+  EXPECT_TRUE(r.hasNote("skipped 1000 cells")) << joined(r.notes);
+  EXPECT_TRUE(r.hasNote("types 100 x1, 101 x1")) << joined(r.notes);
+  EXPECT_TRUE(r.hasNote("115 x1, other types x984)")) << joined(r.notes);
+  EXPECT_LT(r.notes[0].size(), 400u) << r.notes[0];
+}
+
 TEST(IoVtk, ReadsVersion5OffsetsAndPolyData) {
   const std::string version5 =
       "# vtk DataFile Version 5.1\n"
