@@ -3,7 +3,12 @@
 
 #include <gtest/gtest.h>
 
+#include <chrono>
 #include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -73,6 +78,50 @@ inline ReadResult readBytes(io::Format format, const std::vector<uint8_t>& bytes
 
 inline ReadResult readText(io::Format format, const std::string& text, bool weld = false) {
   return readBytes(format, bytesOf(text), weld);
+}
+
+inline ReadResult readPath(const std::filesystem::path& path, bool weld = false) {
+  ReadResult result;
+  io::ReadOptions options;
+  options.weld = weld;
+  result.status = io::readFile(path.string(), result.complex, result.notes, options);
+  return result;
+}
+
+// A unique directory under the system temp directory, removed afterwards.
+class TempDir {
+ public:
+  TempDir() {
+    std::random_device random;
+    path_ = std::filesystem::temp_directory_path() /
+            ("kdmesh_io_test_" +
+             std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()) + "_" +
+             std::to_string(random()));
+    std::filesystem::create_directories(path_);
+  }
+  ~TempDir() {
+    std::error_code ignored;
+    std::filesystem::remove_all(path_, ignored);
+  }
+  std::filesystem::path operator/(const std::string& name) const { return path_ / name; }
+  const std::filesystem::path& path() const { return path_; }
+
+ private:
+  std::filesystem::path path_;
+};
+
+inline void writeWhole(const std::filesystem::path& path, const std::string& text) {
+  std::ofstream out(path, std::ios::binary);
+  out << text;
+}
+
+inline void writeWhole(const std::filesystem::path& path, const std::vector<uint8_t>& bytes) {
+  writeWhole(path, std::string(bytes.begin(), bytes.end()));
+}
+
+inline std::string readWhole(const std::filesystem::path& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
 // Writes `complex` in `format` to memory and reads it back.

@@ -278,5 +278,26 @@ TEST(Attributes, PlyKeepsThemAndOtherFormatsRefuseThem) {
   }
 }
 
+// Welding merges vertices only when their positions and values are all
+// bit-identical: a seam's vertices, with values of their own, stay apart.
+TEST(Attributes, WeldingKeepsVerticesWhoseValuesDiffer) {
+  const std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 4\nproperty float x\nproperty float y\nproperty float z\n"
+      "property uchar red\nproperty uchar green\nproperty uchar blue\nelement face 1\n"
+      "property list uchar int vertex_indices\nend_header\n"
+      "0 0 0 1 2 3\n0 0 0 1 2 3\n0 0 0 9 9 9\n1 0 0 1 2 3\n3 0 2 3\n";
+  Complex c;
+  io::Notes notes;
+  io::ReadOptions options;
+  options.weld = true;
+  ASSERT_TRUE(io::readMemory(io::Format::Ply, reinterpret_cast<const uint8_t*>(ply.data()), ply.size(), c, notes,
+                             options)
+                  .ok());
+  EXPECT_EQ(c.vertexCount(), 3u);
+  ASSERT_EQ(c.attributes.size(), 1u);
+  EXPECT_EQ(c.attributes[0].values, (std::vector<uint8_t>{1, 2, 3, 9, 9, 9, 1, 2, 3}));
+  EXPECT_EQ(c.triangles, (std::vector<uint32_t>{0, 1, 2}));
+}
+
 }  // namespace
 }  // namespace kdmesh::test

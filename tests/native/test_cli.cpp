@@ -106,6 +106,30 @@ class CliTest : public ::testing::Test {
     return r;
   }
 
+  // What /usr/bin/time measured of a run.
+  struct Usage {
+    long residentKilobytes = 0;  // peak
+    double seconds = 0;          // wall time
+  };
+
+  // Runs the tool under /usr/bin/time, which writes `usage`.
+  CliRun runMeasured(const std::string& args, Usage& usage) const {
+    const CliRun r = run(args, "/usr/bin/time -f '%M %e' -o usage.txt");
+    // GNU time puts "Command exited with non-zero status 1" before the figures.
+    const std::string text = readWhole(at("usage.txt"));
+    std::istringstream figures(text.substr(text.find_last_of('\n', text.size() - 2) + 1));
+    figures >> usage.residentKilobytes >> usage.seconds;
+    EXPECT_GT(usage.residentKilobytes, 500) << text;  // a process at all
+    return r;
+  }
+
+  // `head`, then zeros up to `size` bytes: a sparse file, which takes no
+  // disk and no time to write.
+  void writeSparse(const std::string& name, const std::string& head, uintmax_t size) const {
+    writeWhole(at(name), head);
+    fs::resize_file(at(name), size);
+  }
+
   // A successful run: exit 0, which the message shows otherwise.
   CliRun runOk(const std::string& args) const {
     CliRun r = run(args);
@@ -431,20 +455,154 @@ TEST_F(CliTest, MissingMalformedAndUnknownInputsFailWithOneLine) {
 // A PLY or VTK file of another kind is refused after its first block: a
 // sparse 2 GB file, 'ply' not its first line, was read whole (2.3 GB
 // resident) before it was refused.
+constexpr uintmax_t kTwoGigabytes = uintmax_t(2) << 30;
+constexpr long kMemoryBoundKilobytes = 256 << 10;
+
 TEST_F(CliTest, LargeFilesOfAnotherKindAreRefusedWithoutReadingThem) {
   for (const char* name : {"big.ply", "big.vtk"}) {
     SCOPED_TRACE(name);
-    writeWhole(at(name), "solid not really\n");
-    fs::resize_file(at(name), uintmax_t(2) << 30);  // sparse: no disk, no time
-    const CliRun r = run(std::string("encode ") + name + " -o x.kdm", "/usr/bin/time -f %M -o rss.txt");
+    writeSparse(name, "solid not really\n", kTwoGigabytes);
+    Usage usage;
+    const CliRun r = runMeasured(std::string("encode ") + name + " -o x.kdm", usage);
     EXPECT_EQ(r.exitCode, 1) << r.err;
     EXPECT_NE(r.err.find("not a"), std::string::npos) << r.err;
-    // GNU time puts "Command exited with non-zero status 1" before the figure.
-    const std::string times = readWhole(at("rss.txt"));
-    const long residentKilobytes = std::stol(times.substr(times.find_last_of('\n', times.size() - 2) + 1));
-    EXPECT_GT(residentKilobytes, 500) << times;  // a process at all
-    EXPECT_LT(residentKilobytes, 256 << 10) << "peak resident memory";
+    EXPECT_LT(usage.residentKilobytes, kMemoryBoundKilobytes) << "peak resident memory";
     fs::remove(at(name));
+  }
+}
+
+// The 84 bytes that start a binary STL declaring `triangles` triangles.
+std::string stlPrefix(uint32_t triangles) {
+  std::string prefix(84, '\0');
+  for (int i = 0; i < 4; ++i) prefix[80 + i] = char(triangles >> (8 * i));
+  return prefix;
+}
+
+// An all-zero binary STL of 2 GiB whose count is honest: 42,949,671
+// triangles whose corners are all (0,0,0). Streamed and welded as it is
+// read, it takes memory for one vertex and no triangle; the bound on time
+// is for a loaded machine, far above what the work takes.
+TEST_F(CliTest, ATwoGigabyteAllZeroStlWeldsInLittleMemory) {
+  const uint32_t triangles = uint32_t((kTwoGigabytes - 84) / 50);
+  writeSparse("zeros.stl", stlPrefix(triangles), 84 + uintmax_t(50) * triangles);
+  Usage usage;
+  const CliRun r = runMeasured("encode --weld zeros.stl -o zeros.kdm", usage);
+  EXPECT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.err.find("(128849013 -> 1 vertices)"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("dropped 42949671 simplices that welding left"), std::string::npos) << r.err;
+  EXPECT_LT(usage.residentKilobytes, kMemoryBoundKilobytes) << "peak resident memory";
+  EXPECT_LT(usage.seconds, 150.0) << "wall time";
+  fs::remove(at("zeros.stl"));
+}
+
+// A binary STL whose count needs more bytes than the file has is refused on
+// its first 84 bytes; one with bytes after its triangles reads the
+// triangles alone. Neither reads the rest of its 2 GiB.
+TEST_F(CliTest, BinaryStlCountsAreCheckedAgainstTheSizeBeforeReading) {
+  writeSparse("lying.stl", stlPrefix(0xffffffffu), kTwoGigabytes);
+  Usage usage;
+  const CliRun lying = runMeasured("encode lying.stl -o x.kdm", usage);
+  EXPECT_EQ(lying.exitCode, 1) << lying.err;
+  EXPECT_NE(lying.err.find("declares 4294967295 triangles"), std::string::npos) << lying.err;
+  EXPECT_NE(lying.err.find("truncated"), std::string::npos) << lying.err;
+  EXPECT_LT(usage.residentKilobytes, kMemoryBoundKilobytes) << "peak resident memory";
+  fs::remove(at("lying.stl"));
+
+  writeSparse("short.stl", stlPrefix(1), kTwoGigabytes);
+  const CliRun trailing = runMeasured("encode short.stl -o x.kdm", usage);
+  EXPECT_EQ(trailing.exitCode, 0) << trailing.err;
+  EXPECT_NE(trailing.err.find("ignored 2147483514 bytes after the triangles"), std::string::npos)
+      << trailing.err;
+  EXPECT_LT(usage.residentKilobytes, kMemoryBoundKilobytes) << "peak resident memory";
+  fs::remove(at("short.stl"));
+}
+
+// A binary PLY body is streamed: 2 GiB after its elements are not read.
+TEST_F(CliTest, ABinaryPlyBodyIsStreamed) {
+  std::string ply =
+      "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n"
+      "property float y\nproperty float z\nelement face 1\n"
+      "property list uchar int vertex_indices\nend_header\n";
+  const float corners[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  const int32_t face[3] = {0, 1, 2};
+  ply.append(reinterpret_cast<const char*>(corners), sizeof corners);
+  ply += '\3';
+  ply.append(reinterpret_cast<const char*>(face), sizeof face);
+  const uintmax_t trailing = kTwoGigabytes - ply.size();
+  writeSparse("tail.ply", ply, kTwoGigabytes);
+  Usage usage;
+  const CliRun r = runMeasured("encode tail.ply -o x.kdm", usage);
+  EXPECT_EQ(r.exitCode, 0) << r.err;
+  EXPECT_NE(r.err.find("ignored " + std::to_string(trailing) + " bytes after the last PLY element"),
+            std::string::npos)
+      << r.err;
+  EXPECT_LT(usage.residentKilobytes, kMemoryBoundKilobytes) << "peak resident memory";
+  fs::remove(at("tail.ply"));
+}
+
+// Runs the tool with an address-space limit far below what the lying counts
+// below would reserve, so that reserving before checking fails visibly (as
+// [limit-exceeded]). AddressSanitizer maps terabytes of shadow memory and
+// cannot run under such a limit: there, only the messages are checked.
+#if defined(__has_feature)
+#if __has_feature(address_sanitizer)
+#define KDMESH_ADDRESS_SANITIZER 1
+#endif
+#endif
+#if defined(__SANITIZE_ADDRESS__)
+#define KDMESH_ADDRESS_SANITIZER 1
+#endif
+std::string addressSpaceLimit() {
+#if defined(KDMESH_ADDRESS_SANITIZER)
+  return "";
+#else
+  return "prlimit --as=" + std::to_string(512 << 20) + " --";
+#endif
+}
+
+// Counts in a header that the rest of the file cannot hold are refused
+// before anything is reserved for them, in every format that has counts:
+// each would reserve gigabytes.
+TEST_F(CliTest, HeaderCountsBeyondTheFileReserveNothing) {
+  const std::string vtk = "# vtk DataFile Version 3.0\nt\nASCII\nDATASET UNSTRUCTURED_GRID\n";
+  const std::string vtk5 = "# vtk DataFile Version 5.1\nt\nASCII\nDATASET UNSTRUCTURED_GRID\n";
+  const std::string plyVertices =
+      " 1.0\nelement vertex 2147483648\nproperty float x\nproperty float y\n"
+      "property float z\nend_header\n";
+  writeWhole(at("pair.node"), "1 3 0 0\n1 0 0 0\n");
+  const struct {
+    const char* name;
+    std::string text;
+    const char* expected;
+  } lies[] = {
+      {"binary.ply", "ply\nformat binary_little_endian" + plyVertices + std::string(24, '\0'),
+       "more than the rest of the file"},
+      {"ascii.ply", "ply\nformat ascii" + plyVertices + "0 0 0\n", "more than the rest of the file"},
+      {"faces.ply",
+       "ply\nformat binary_little_endian 1.0\nelement vertex 1\nproperty float x\n"
+       "property float y\nproperty float z\nelement face 1000000000\n"
+       "property list uchar int vertex_indices\nend_header\n" + std::string(40, '\0'),
+       "more than the rest of the file"},
+      {"lie.off", "OFF\n1000000000 1000000000 0\n0 0 0\n", "more than the rest of the file"},
+      {"lie.mesh", "MeshVersionFormatted 1\nDimension 3\nVertices 1000000000\n0 0 0 0\n",
+       "more than the rest of the file"},
+      {"lie.node", "1000000000 3 0 0\n1 0 0 0\n", "more than the rest of the file"},
+      {"pair.ele", "1000000000 4 0\n1 1 1 1 1\n", "more than the rest of the file"},
+      {"points.vtk", vtk + "POINTS 1000000000 float\n0 0 0\n", "more than the rest of the file"},
+      {"cells.vtk", vtk + "POINTS 1 float\n0 0 0\nCELLS 1000000000 2000000000\n1 0\n",
+       "more than the rest of the file"},
+      {"offsets.vtk", vtk5 + "POINTS 1 float\n0 0 0\nCELLS 1000000000 1000000000\nOFFSETS vtktypeint64\n0\n",
+       "more than the rest of the file"},
+      {"lie.stl", stlPrefix(1u << 30) + std::string(50, '\0'), "truncated"},
+  };
+  for (const auto& lie : lies) {
+    SCOPED_TRACE(lie.name);
+    writeWhole(at(lie.name), lie.text);
+    const CliRun r = run(std::string("encode ") + lie.name + " -o x.kdm", addressSpaceLimit());
+    EXPECT_EQ(r.signal, 0);
+    EXPECT_EQ(r.exitCode, 1) << r.err;
+    EXPECT_NE(r.err.find(lie.expected), std::string::npos) << r.err;
+    EXPECT_EQ(r.err.find("limit-exceeded"), std::string::npos) << r.err;
   }
 }
 

@@ -25,14 +25,6 @@ namespace {
 namespace fs = std::filesystem;
 using io::Format;
 
-ReadResult readPath(const fs::path& path, bool weld = false) {
-  ReadResult result;
-  io::ReadOptions options;
-  options.weld = weld;
-  result.status = io::readFile(path.string(), result.complex, result.notes, options);
-  return result;
-}
-
 // Every prefix of `full` either reads (with valid indices) or fails with a
 // one-line InvalidInput error and an empty complex; none crashes.
 void expectPrefixesReadOrFailCleanly(Format format, const std::vector<uint8_t>& full,
@@ -112,38 +104,6 @@ Complex tetrahedralComplex() {
   c.positions = awkwardPositions(9);
   c.tetrahedra = {3, 2, 1, 0, 4, 5, 7, 6, 0, 8, 4, 2};
   return c;
-}
-
-// A unique directory under the system temp directory, removed afterwards.
-class TempDir {
- public:
-  TempDir() {
-    std::random_device random;
-    path_ = fs::temp_directory_path() /
-            ("kdmesh_io_formats_" +
-             std::to_string(std::chrono::steady_clock::now().time_since_epoch().count()) + "_" +
-             std::to_string(random()));
-    fs::create_directories(path_);
-  }
-  ~TempDir() {
-    std::error_code ignored;
-    fs::remove_all(path_, ignored);
-  }
-  fs::path operator/(const std::string& name) const { return path_ / name; }
-  const fs::path& path() const { return path_; }
-
- private:
-  fs::path path_;
-};
-
-void writeWhole(const fs::path& path, const std::string& text) {
-  std::ofstream out(path, std::ios::binary);
-  out << text;
-}
-
-std::string readWhole(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return std::string(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
 }
 
 // ---------------------------------------------------------------------------
@@ -284,7 +244,7 @@ TEST(IoStl, WeldMergesBitIdenticalVerticesOnly) {
     EXPECT_TRUE(welded.hasNote("6 -> 4")) << joined(welded.notes);
   }
   // +0 and -0 differ in their bits and stay apart; a triangle whose corners
-  // weld together is kept and noted.
+  // weld together is dropped and noted, its vertices kept.
   std::vector<StlTriangle> signs = {
       {{0, 0, 1}, {0.0f, 0, 0, -0.0f, 0, 0, 1, 1, 1}, 0},
       {{0, 0, 1}, {2, 2, 2, 2, 2, 2, 3, 3, 3}, 0},
@@ -292,8 +252,9 @@ TEST(IoStl, WeldMergesBitIdenticalVerticesOnly) {
   const ReadResult welded = readBytes(Format::Stl, binaryStl("x", signs), true);
   ASSERT_TRUE(welded.status.ok()) << welded.status.message;
   EXPECT_EQ(welded.complex.vertexCount(), 5u);
-  EXPECT_EQ(welded.complex.triangles, (std::vector<uint32_t>{0, 1, 2, 3, 3, 4}));
-  EXPECT_TRUE(welded.hasNote("1 simplices have a repeated vertex")) << joined(welded.notes);
+  EXPECT_EQ(welded.complex.triangles, (std::vector<uint32_t>{0, 1, 2}));
+  EXPECT_TRUE(welded.hasNote("dropped 1 simplices that welding left with a repeated vertex"))
+      << joined(welded.notes);
 
   // readFile passes the option on.
   TempDir dir;
@@ -734,6 +695,25 @@ TEST(IoVtk, ReadsUnstructuredGridWithEveryCellKindCrlfAndIgnoredData) {
     EXPECT_TRUE(r.hasNote("double")) << joined(r.notes);
     EXPECT_TRUE(r.hasNote("ignored 1 FIELD")) << joined(r.notes);
   }
+}
+
+// A cell type of its own in every cell: the note names a few types and
+// counts the rest, rather than growing with the file.
+TEST(IoVtk, ManySkippedCellTypesMakeAShortNote) {
+  std::string cells, types;
+  for (int c = 0; c < 1000; ++c) {
+    cells += "1 0\n";
+    types += std::to_string(100 + c) + "\n";
+  }
+  const ReadResult r = readText(Format::Vtk, "# vtk DataFile Version 3.0\nt\nASCII\n"
+                                             "DATASET UNSTRUCTURED_GRID\nPOINTS 1 float\n0 0 0\n"
+                                             "CELLS 1000 2000\n" + cells + "CELL_TYPES 1000\n" + types);
+  ASSERT_TRUE(r.status.ok()) << r.status.message;
+  ASSERT_EQ(r.notes.size(), 1u) << joined(r.notes);
+  EXPECT_TRUE(r.hasNote("skipped 1000 cells")) << joined(r.notes);
+  EXPECT_TRUE(r.hasNote("types 100 x1, 101 x1")) << joined(r.notes);
+  EXPECT_TRUE(r.hasNote("115 x1, other types x984)")) << joined(r.notes);
+  EXPECT_LT(r.notes[0].size(), 400u) << r.notes[0];
 }
 
 TEST(IoVtk, ReadsVersion5OffsetsAndPolyData) {

@@ -5,7 +5,8 @@
 // reads: malformed text, truncated binaries, counts that do not fit the file
 // and out-of-range indices are errors with a one-line message naming the
 // place (line number or element index), never a crash or an allocation the
-// file size does not justify.
+// file size does not justify. readFile streams the bodies of binary STL and
+// PLY files in blocks; the other formats are read whole, in one allocation.
 #pragma once
 
 #include <cstdint>
@@ -43,16 +44,20 @@ struct ReadOptions {
   // apart), keeping the first of each and the order of first appearance, and
   // renumber the simplices; a note gives the count. Meant for STL, a triangle
   // soup with three vertices of its own per triangle, but works for every
-  // format. Simplices that welding leaves with a repeated vertex are kept
-  // (and noted): the encoder drops them as degenerate.
+  // format. Simplices that welding leaves with a repeated vertex are
+  // dropped, and a note counts them (the encoder would drop them as
+  // degenerate). STL welds each corner as it is read, so that a soup takes
+  // memory for its distinct vertices rather than three per triangle.
   bool weld = false;
 };
 
 // Format notes:
 // - STL: binary when the size is 84 + 50 * (the count at byte 80), or when
-//   the text is not "solid" followed by a "facet" or "endsolid" line (binary
-//   headers often start with "solid" too). Three new vertices per triangle,
-//   as given; facet normals and attribute bytes are ignored.
+//   the first 64 KiB are not "solid" followed by a "facet" or "endsolid" line
+//   (binary headers often start with "solid" too). A count that needs more
+//   bytes than the file has is an error; bytes after the triangles are
+//   ignored with a note. Three new vertices per triangle, as given; facet
+//   normals and attribute bytes are ignored.
 // - Medit: Dimension 3 only. Quadrilaterals are split into two triangles
 //   (a note says how many); Hexahedra, Prisms, Pyramids, P2/Q2 elements and
 //   known per-item sections (Corners, Ridges, Required*, Normals, ...) are

@@ -1,35 +1,43 @@
 // Format dispatch and file access for kdmesh/io.h.
-#include <algorithm>
 #include <cerrno>
 #include <cstdio>
-#include <cstring>
-#include <memory>
 
 #include "io/io_internal.h"
 
 namespace kdmesh::io {
 
+using detail::Bytes;
+using detail::ByteStream;
+using detail::FilePtr;
+using detail::Input;
 using detail::inputError;
 
 namespace {
 
-struct FileCloser {
-  void operator()(std::FILE* file) const { std::fclose(file); }
-};
-using FilePtr = std::unique_ptr<std::FILE, FileCloser>;
-
 Status fileError(const char* action, const std::string& path) {
-  return Status::error(ErrorCode::InvalidArgument, std::string(action) + " " +
-                                                       path + ": " +
-                                                       std::strerror(errno));
+  return detail::fileError(action, path, errno);
 }
 
-bool isBlank(const uint8_t* data, size_t size) {
-  for (size_t i = 0; i < size; ++i) {
-    switch (data[i]) {
-      case ' ': case '\t': case '\r': case '\n': case '\v': case '\f': break;
-      default: return false;
-    }
+bool isBlank(uint8_t byte) {
+  switch (byte) {
+    case ' ': case '\t': case '\r': case '\n': case '\v': case '\f':
+      return true;
+    default:
+      return false;
+  }
+}
+
+// Looks at the first block, and past it only while the bytes stay blank, so
+// that a large file is not read to tell that it is not empty.
+bool isBlank(Input& input) {
+  const Bytes head = input.head();
+  for (size_t i = 0; i < head.size; ++i) {
+    if (!isBlank(head.data[i])) return false;
+  }
+  if (input.headIsWhole()) return true;
+  ByteStream rest = input.stream(head.size);
+  while (const uint8_t* byte = rest.take(1)) {
+    if (!isBlank(*byte)) return false;
   }
   return true;
 }
@@ -94,33 +102,65 @@ std::string extensionOf(const std::string& path) {
   return extension;
 }
 
-// Checks the first bytes of a file before the rest is read.
+// Checks the first bytes of a file before the rest is read: a PLY or VTK
+// file of another kind is refused without reading all of it.
 using HeadCheck = Status (*)(const uint8_t* head, size_t size);
 
-// Reads a whole file. `missing` tells whether it failed because the file
-// does not exist; `checkHead`, if given, sees the first block (64 KiB, or
-// the whole file if shorter) and can refuse the file before more is read.
-Status readWholeFile(const std::string& path, std::vector<uint8_t>& bytes,
-                     bool* missing = nullptr, HeadCheck checkHead = nullptr) {
-  FilePtr file(std::fopen(path.c_str(), "rb"));
-  if (!file) {
-    if (missing) *missing = errno == ENOENT;
-    return fileError("cannot open", path);
+HeadCheck headCheckOf(Format format) {
+  switch (format) {
+    case Format::Ply: return detail::checkPlySignature;
+    case Format::Vtk: return detail::checkVtkSignature;
+    default: return nullptr;
   }
-  // Read in growing blocks rather than trusting a size from fseek/ftell, which
-  // pipes and special files do not give.
-  size_t used = 0;
-  for (size_t block = 1 << 16;; block = std::min<size_t>(block * 2, 1 << 26)) {
-    bytes.resize(used + block);
-    const size_t got = std::fread(bytes.data() + used, 1, block, file.get());
-    if (used == 0 && checkHead && !std::ferror(file.get()))
-      if (Status status = checkHead(bytes.data(), got); !status.ok()) return status;
-    used += got;
-    if (got < block) break;
+}
+
+// Runs the reader of `format` on `input`, which is not blank.
+Status readFormat(Format format, Input& input, Complex& out, Notes& notes,
+                  bool weld) {
+  if (const HeadCheck check = headCheckOf(format)) {
+    const Bytes head = input.head();
+    if (Status status = check(head.data, head.size); !status.ok()) {
+      return status;
+    }
   }
-  if (std::ferror(file.get())) return fileError("cannot read", path);
-  bytes.resize(used);
-  return Status::success();
+  // STL and PLY read what they need; the others parse all the text.
+  if (format == Format::Stl) return detail::readStl(input, out, notes, weld);
+  if (format == Format::Ply) return detail::readPly(input, out, notes);
+  const Bytes all = input.whole();
+  switch (format) {
+    case Format::Obj: return detail::readObj(all.data, all.size, out, notes);
+    case Format::Off: return detail::readOff(all.data, all.size, out, notes);
+    case Format::Xyz: return detail::readXyz(all.data, all.size, out, notes);
+    case Format::Medit:
+      return detail::readMedit(all.data, all.size, out, notes);
+    case Format::Vtk: return detail::readVtk(all.data, all.size, out, notes);
+    case Format::TetGen: {  // one buffer: the .node file alone
+      uint32_t firstIndex = 0;
+      return detail::readTetgenNode(all.data, all.size, out, notes,
+                                    firstIndex);
+    }
+    default: break;
+  }
+  return Status::error(ErrorCode::InvalidArgument, "unknown file format");
+}
+
+// Reads `input` in `format` into `out`, which it empties on error. A failed
+// read of the file is the error even when the reader saw it as truncation.
+Status readInput(Format format, Input& input, Complex& out, Notes& notes,
+                 const ReadOptions& options) {
+  out = Complex{};
+  Status status = isBlank(input)
+                      ? inputError("file is empty")
+                      : readFormat(format, input, out, notes, options.weld);
+  if (Status readError = input.readError(); !readError.ok()) {
+    status = readError;
+  }
+  if (!status.ok()) {
+    out = Complex{};
+  } else if (options.weld && format != Format::Stl) {  // STL welds as it reads
+    detail::weldVertices(out, notes);
+  }
+  return status;
 }
 
 Status writeWholeFile(const std::string& path,
@@ -163,33 +203,43 @@ Status inFile(Status status, const std::string& file,
   return status;
 }
 
-Status readTetgenFiles(const std::string& path, Complex& out, Notes& notes) {
-  const TetgenPaths paths = tetgenPaths(path);
-  std::vector<uint8_t> bytes;
-  if (Status status = readWholeFile(paths.node, bytes); !status.ok()) {
+// Opens one file of a TetGen pair and checks that it is not blank.
+Status openTetgenFile(const std::string& file, const std::string& given,
+                      Input& input, bool* missing = nullptr) {
+  if (Status status = Input::open(file, input, missing); !status.ok()) {
     return status;
   }
-  if (isBlank(bytes.data(), bytes.size())) {
-    return inFile(inputError("file is empty"), paths.node, path);
+  const bool blank = isBlank(input);
+  if (Status status = input.readError(); !status.ok()) return status;
+  return blank ? inFile(inputError("file is empty"), file, given)
+               : Status::success();
+}
+
+Status readTetgenFiles(const std::string& path, Complex& out, Notes& notes) {
+  const TetgenPaths paths = tetgenPaths(path);
+  Input node;
+  if (Status status = openTetgenFile(paths.node, path, node); !status.ok()) {
+    return status;
   }
   uint32_t firstIndex = 0;
-  Status status = detail::readTetgenNode(bytes.data(), bytes.size(), out,
-                                         notes, firstIndex);
+  Bytes bytes = node.whole();
+  Status status = detail::readTetgenNode(bytes.data, bytes.size, out, notes,
+                                         firstIndex);
+  if (Status readError = node.readError(); !readError.ok()) return readError;
   if (!status.ok()) return inFile(status, paths.node, path);
 
+  Input ele;
   bool missing = false;
-  bytes.clear();
-  status = readWholeFile(paths.ele, bytes, &missing);
+  status = openTetgenFile(paths.ele, path, ele, &missing);
   if (!status.ok()) {
     if (!missing || paths.givenEle) return status;
     notes.push_back("no " + paths.ele + ": read the nodes as a point cloud");
     return Status::success();
   }
-  if (isBlank(bytes.data(), bytes.size())) {
-    return inFile(inputError("file is empty"), paths.ele, path);
-  }
-  status = detail::readTetgenEle(bytes.data(), bytes.size(), firstIndex, out,
+  bytes = ele.whole();
+  status = detail::readTetgenEle(bytes.data, bytes.size, firstIndex, out,
                                  notes);
+  if (Status readError = ele.readError(); !readError.ok()) return readError;
   return inFile(status, paths.ele, path);
 }
 
@@ -250,31 +300,8 @@ Status readMemory(Format format, const uint8_t* data, size_t size,
   if (format == Format::Unknown) {
     return Status::error(ErrorCode::InvalidArgument, "unknown file format");
   }
-  if (isBlank(data, size)) return inputError("file is empty");
-  Status status;
-  switch (format) {
-    case Format::Ply: status = detail::readPly(data, size, out, notes); break;
-    case Format::Obj: status = detail::readObj(data, size, out, notes); break;
-    case Format::Off: status = detail::readOff(data, size, out, notes); break;
-    case Format::Xyz: status = detail::readXyz(data, size, out, notes); break;
-    case Format::Stl: status = detail::readStl(data, size, out, notes); break;
-    case Format::Medit:
-      status = detail::readMedit(data, size, out, notes);
-      break;
-    case Format::Vtk: status = detail::readVtk(data, size, out, notes); break;
-    case Format::TetGen: {  // one buffer: the .node file alone
-      uint32_t firstIndex = 0;
-      status = detail::readTetgenNode(data, size, out, notes, firstIndex);
-      break;
-    }
-    case Format::Unknown: break;
-  }
-  if (!status.ok()) {
-    out = Complex{};
-  } else if (options.weld) {
-    detail::weldVertices(out, notes);
-  }
-  return status;
+  Input input(data, size);
+  return readInput(format, input, out, notes, options);
 }
 
 Status readFile(const std::string& path, Complex& out, Notes& notes,
@@ -291,12 +318,9 @@ Status readFile(const std::string& path, Complex& out, Notes& notes,
     }
     return status;
   }
-  std::vector<uint8_t> bytes;
-  const HeadCheck checkHead = format == Format::Ply   ? detail::checkPlySignature
-                              : format == Format::Vtk ? detail::checkVtkSignature
-                                                      : nullptr;
-  if (Status status = readWholeFile(path, bytes, nullptr, checkHead); !status.ok()) return status;
-  return readMemory(format, bytes.data(), bytes.size(), out, notes, options);
+  Input input;
+  if (Status status = Input::open(path, input); !status.ok()) return status;
+  return readInput(format, input, out, notes, options);
 }
 
 // Only PLY holds vertex attributes: other formats refuse a complex with

@@ -2,6 +2,8 @@
 #pragma once
 
 #include <cstdint>
+#include <cstdio>
+#include <memory>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -9,6 +11,109 @@
 #include "kdmesh/io.h"
 
 namespace kdmesh::io::detail {
+
+// ---------------------------------------------------------------------------
+// Input bytes
+// ---------------------------------------------------------------------------
+
+struct FileCloser {
+  void operator()(std::FILE* file) const { std::fclose(file); }
+};
+using FilePtr = std::unique_ptr<std::FILE, FileCloser>;
+
+// A run of bytes held in memory.
+struct Bytes {
+  const uint8_t* data = nullptr;
+  size_t size = 0;
+};
+
+// Bytes read front to back: from memory, or from a file in blocks, so that a
+// binary body is read without holding the whole file.
+class ByteStream {
+ public:
+  // The `size` bytes at `data`, which are bytes `offset` on of the input.
+  ByteStream(const uint8_t* data, size_t size, uint64_t offset);
+  // Bytes `offset` to `end` of `file`; a read error sets `*readError` to
+  // errno and ends the stream early.
+  ByteStream(std::FILE* file, uint64_t offset, uint64_t end, int* readError);
+  // Moving keeps the block (and the pointers into it); a copy would not.
+  ByteStream(ByteStream&&) = default;
+  ByteStream(const ByteStream&) = delete;
+  ByteStream& operator=(const ByteStream&) = delete;
+
+  // The next `count` bytes (at most kBlockBytes), or nullptr when fewer
+  // remain.
+  const uint8_t* take(size_t count);
+  // Moves past `count` bytes; false when fewer remain.
+  bool skip(uint64_t count);
+  // Offset of the next byte in the input, for messages.
+  uint64_t offset() const {
+    return windowOffset_ + static_cast<uint64_t>(cursor_ - window_);
+  }
+  uint64_t remaining() const { return end_ - offset(); }
+
+  static constexpr size_t kBlockBytes = size_t{1} << 20;
+
+ private:
+  bool refill(size_t count);
+
+  std::FILE* file_ = nullptr;
+  int* readError_ = nullptr;
+  std::vector<uint8_t> buffer_;  // a file's current block
+  const uint8_t* window_;        // the bytes held: [window_, limit_)
+  const uint8_t* cursor_;
+  const uint8_t* limit_;
+  uint64_t windowOffset_;        // input offset of window_
+  uint64_t end_;                 // input offset of the end
+};
+
+// What a reader reads: a buffer, or a file read as the reader asks, so that
+// a binary format can be streamed and a file of the wrong kind refused on
+// its first bytes.
+class Input {
+ public:
+  static constexpr size_t kHeadBytes = size_t{1} << 16;
+
+  Input(const uint8_t* data, size_t size);
+  // Opens `path`; `missing` tells whether it failed because the file does
+  // not exist.
+  static Status open(const std::string& path, Input& input,
+                     bool* missing = nullptr);
+  Input() = default;
+  Input(const Input&) = delete;
+  Input& operator=(const Input&) = delete;
+
+  // The first kHeadBytes bytes, or all if fewer. The bytes that head() and
+  // whole() give stay valid as long as the Input.
+  Bytes head();
+  // Whether head() holds every byte.
+  bool headIsWhole();
+  // Every byte; a file is read now, in one allocation when it is a regular
+  // file (whose size is known).
+  Bytes whole();
+  // The size in bytes. A file that is not regular (a pipe) is read whole
+  // first to learn it.
+  uint64_t size();
+  // The bytes from `offset` on; a regular file is read in blocks.
+  ByteStream stream(uint64_t offset);
+  // The error of a failed read from the file, or success.
+  Status readError() const;
+
+ private:
+  FilePtr file_;
+  std::string path_;
+  bool sized_ = false;        // a regular file whose size_ is known
+  uint64_t size_ = 0;
+  std::vector<uint8_t> head_;
+  bool haveHead_ = false;
+  std::vector<uint8_t> all_;  // a file read whole
+  Bytes whole_;               // valid once known
+  bool haveWhole_ = false;
+  int readError_ = 0;         // errno of a failed read
+};
+
+// "`action` `path`: " and the text of errno value `error`.
+Status fileError(const char* action, const std::string& path, int error);
 
 // ---------------------------------------------------------------------------
 // Reading text
@@ -135,7 +240,9 @@ class TextOut {
 // ---------------------------------------------------------------------------
 
 // Readers append to an empty `out`; readMemory clears it again on error.
-Status readPly(const uint8_t* data, size_t size, Complex& out, Notes& notes);
+// PLY streams a binary body from a file; its header may run past the first
+// block of the input.
+Status readPly(Input& input, Complex& out, Notes& notes);
 // The first line of a PLY or legacy VTK file, checked on the file's first
 // bytes before the rest is read: a file of another kind is refused without
 // reading all of it.
@@ -144,7 +251,9 @@ Status checkVtkSignature(const uint8_t* head, size_t size);
 Status readObj(const uint8_t* data, size_t size, Complex& out, Notes& notes);
 Status readOff(const uint8_t* data, size_t size, Complex& out, Notes& notes);
 Status readXyz(const uint8_t* data, size_t size, Complex& out, Notes& notes);
-Status readStl(const uint8_t* data, size_t size, Complex& out, Notes& notes);
+// STL streams a binary file, and welds as it reads when `weld` is set, so
+// that a soup takes memory for its distinct vertices only.
+Status readStl(Input& input, Complex& out, Notes& notes, bool weld);
 Status readMedit(const uint8_t* data, size_t size, Complex& out, Notes& notes);
 Status readVtk(const uint8_t* data, size_t size, Complex& out, Notes& notes);
 // A TetGen .node file; `firstIndex` receives the number of its first point
@@ -156,7 +265,42 @@ Status readTetgenNode(const uint8_t* data, size_t size, Complex& out,
 Status readTetgenEle(const uint8_t* data, size_t size, uint32_t firstIndex,
                      Complex& out, Notes& notes);
 
-// Merges vertices with bit-identical positions (ReadOptions::weld).
+// ---------------------------------------------------------------------------
+// Welding (ReadOptions::weld)
+// ---------------------------------------------------------------------------
+
+// Gives each position the index of the first vertex with the same bits,
+// appending the position when it is new. The hash is drawn at random for
+// every Welder from a strongly universal family (multiply-shift over the
+// three 32-bit words), so no input makes it collide on purpose: the expected
+// work per vertex stays small whatever the positions.
+class Welder {
+ public:
+  // `positions` must start empty; the welded vertices are appended to it.
+  explicit Welder(std::vector<float>& positions);
+  uint32_t vertexAt(const float* xyz);
+
+ private:
+  size_t slotOf(const uint32_t* bits) const;
+  void grow();
+
+  static constexpr uint32_t kEmpty = 0xffffffffu;
+  std::vector<float>& positions_;
+  std::vector<uint32_t> slots_;  // vertex indices, kEmpty where none
+  uint64_t multipliers_[4];
+  int shift_ = 0;  // 64 - log2(table size)
+};
+
+// Removes the simplices of `indices` (`arity` vertices each) from the one
+// starting at `first` on that have a repeated vertex; returns how many.
+size_t dropRepeated(std::vector<uint32_t>& indices, size_t arity,
+                    size_t first = 0);
+
+// The notes of a weld of `before` vertices into `after` that dropped
+// `dropped` simplices.
+void addWeldNotes(Notes& notes, size_t before, size_t after, size_t dropped);
+
+// Merges vertices with bit-identical positions in a complex read whole.
 void weldVertices(Complex& complex, Notes& notes);
 
 // Writers receive a complex whose array sizes and indices are valid.

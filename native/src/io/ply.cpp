@@ -529,47 +529,48 @@ class AsciiValues {
 
 class BinaryValues {
  public:
-  BinaryValues(const uint8_t* data, size_t begin, size_t end, bool bigEndian)
-      : data_(data), cursor_(begin), end_(end), bigEndian_(bigEndian) {}
+  BinaryValues(ByteStream& bytes, bool bigEndian)
+      : bytes_(bytes), bigEndian_(bigEndian) {}
 
   bool coordinate(Scalar type, float& value) {
-    if (!available(type)) return false;
+    const uint8_t* bytes = take(type);
+    if (bytes == nullptr) return false;
     // float32 goes straight through so that even NaN payloads keep their bits.
     value = type == Scalar::Float32
-                ? loadScalar<float>(data_ + cursor_, bigEndian_)
-                : static_cast<float>(
-                      loadAsDouble(type, data_ + cursor_, bigEndian_));
-    cursor_ += scalarBytes(type);
+                ? loadScalar<float>(bytes, bigEndian_)
+                : static_cast<float>(loadAsDouble(type, bytes, bigEndian_));
     return true;
   }
   // Only called for integer types, which double holds exactly.
   bool integer(Scalar type, int64_t& value) {
-    if (!available(type)) return false;
-    value = static_cast<int64_t>(
-        loadAsDouble(type, data_ + cursor_, bigEndian_));
-    cursor_ += scalarBytes(type);
+    const uint8_t* bytes = take(type);
+    if (bytes == nullptr) return false;
+    value = static_cast<int64_t>(loadAsDouble(type, bytes, bigEndian_));
     return true;
   }
   bool skip(Scalar type, uint64_t count) {
-    if (!canHold(count, type)) return fail(kTruncated);
-    cursor_ += count * scalarBytes(type);
+    if (!canHold(count, type) || !bytes_.skip(count * scalarBytes(type))) {
+      return fail(kTruncated);
+    }
     return true;
   }
   // One attribute value of `type` into `out`, in memory order
   // (little-endian).
   bool attribute(Scalar type, uint8_t* out) {
-    if (!available(type)) return false;
+    const uint8_t* value = take(type);
+    if (value == nullptr) return false;
     const size_t bytes = scalarBytes(type);
-    for (size_t i = 0; i < bytes; ++i) out[i] = data_[cursor_ + (bigEndian_ ? bytes - 1 - i : i)];
-    cursor_ += bytes;
+    for (size_t i = 0; i < bytes; ++i) out[i] = value[bigEndian_ ? bytes - 1 - i : i];
     return true;
   }
   static uint64_t minBytes(Scalar type) { return scalarBytes(type); }
   bool canHold(uint64_t count, Scalar type) const {
     return count <= remainingBytes() / scalarBytes(type);
   }
-  uint64_t remainingBytes() const { return end_ - cursor_; }
-  std::string place() const { return "byte " + std::to_string(cursor_); }
+  uint64_t remainingBytes() const { return bytes_.remaining(); }
+  std::string place() const {
+    return "byte " + std::to_string(bytes_.offset());
+  }
   bool fail(std::string problem) {
     problem_ = std::move(problem);
     return false;
@@ -580,13 +581,14 @@ class BinaryValues {
   static constexpr const char* kTruncated =
       "the data ends early (truncated file)";
 
-  bool available(Scalar type) {
-    return remainingBytes() >= scalarBytes(type) || fail(kTruncated);
+  // The bytes of one value, or nullptr (and the problem) at the end.
+  const uint8_t* take(Scalar type) {
+    const uint8_t* bytes = bytes_.take(scalarBytes(type));
+    if (bytes == nullptr) fail(kTruncated);
+    return bytes;
   }
 
-  const uint8_t* data_;
-  size_t cursor_;
-  size_t end_;
+  ByteStream& bytes_;
   bool bigEndian_;
   std::string problem_;
 };
@@ -803,10 +805,58 @@ Status checkPlySignature(const uint8_t* head, size_t size) {
   return readPlySignature(scanner);
 }
 
-Status readPly(const uint8_t* data, size_t size, Complex& out, Notes& notes) {
-  TextScanner scanner(data, size);
+namespace {
+
+// Parses the header from the first block of the input, or from all of it
+// when the block ends before the line that decides (end_header or an
+// error). `body` receives the offset of the byte after end_header's line.
+Status readHeader(Input& input, PlyHeader& header, uint64_t& body) {
+  const Bytes head = input.head();
+  TextScanner scanner(head.data, head.size);
+  Status status = parseHeader(scanner, header);
+  body = scanner.nextLineOffset();
+  if (body < head.size || input.headIsWhole()) return status;
+  const Bytes all = input.whole();
+  TextScanner whole(all.data, all.size);
+  header = PlyHeader{};
+  status = parseHeader(whole, header);
+  body = whole.nextLineOffset();
+  return status;
+}
+
+// The ascii body, read from all of the input, with the line numbers of the
+// file.
+Status readAsciiBody(Input& input, const PlyHeader& header,
+                     const std::vector<ElementPlan>& plans, BodyState& state,
+                     uint64_t& trailingValues) {
+  const Bytes all = input.whole();
+  TextScanner scanner(all.data, all.size);
+  PlyHeader again;  // moves the scanner past the header, already checked
+  if (Status status = parseHeader(scanner, again); !status.ok()) return status;
+  AsciiValues values(scanner);
+  Status status = readBody(values, header, plans, state);
+  std::string_view token;
+  while (status.ok() && scanner.nextTokenAcrossLines(token)) ++trailingValues;
+  return status;
+}
+
+// The binary body, streamed from `body` on.
+Status readBinaryBody(Input& input, uint64_t body, const PlyHeader& header,
+                      const std::vector<ElementPlan>& plans,
+                      BodyState& state, uint64_t& trailingBytes) {
+  ByteStream bytes = input.stream(body);
+  BinaryValues values(bytes, header.encoding == Encoding::BinaryBigEndian);
+  Status status = readBody(values, header, plans, state);
+  trailingBytes = values.remainingBytes();
+  return status;
+}
+
+}  // namespace
+
+Status readPly(Input& input, Complex& out, Notes& notes) {
   PlyHeader header;
-  if (Status status = parseHeader(scanner, header); !status.ok()) {
+  uint64_t body = 0;
+  if (Status status = readHeader(input, header, body); !status.ok()) {
     return status;
   }
   std::vector<ElementPlan> plans;
@@ -818,20 +868,12 @@ Status readPly(const uint8_t* data, size_t size, Complex& out, Notes& notes) {
   for (const ElementPlan& plan : plans)
     if (plan.role == Role::Vertex) out.attributes = plan.attributes;
   BodyState state{out, vertexCount, {}, {}};
-  Status status;
   uint64_t trailingBytes = 0;
   uint64_t trailingValues = 0;
-  if (header.encoding == Encoding::Ascii) {
-    AsciiValues values(scanner);
-    status = readBody(values, header, plans, state);
-    std::string_view token;
-    while (status.ok() && scanner.nextTokenAcrossLines(token)) ++trailingValues;
-  } else {
-    BinaryValues values(data, scanner.nextLineOffset(), size,
-                        header.encoding == Encoding::BinaryBigEndian);
-    status = readBody(values, header, plans, state);
-    trailingBytes = values.remainingBytes();
-  }
+  Status status =
+      header.encoding == Encoding::Ascii
+          ? readAsciiBody(input, header, plans, state, trailingValues)
+          : readBinaryBody(input, body, header, plans, state, trailingBytes);
   if (!status.ok()) return status;
   state.split.addNote(notes);
   addCountNote(notes, "ignored ", trailingBytes,

@@ -8,10 +8,15 @@
 //   facet normal nx ny nz / outer loop / vertex x y z (3 times) / endloop /
 //   endfacet
 // and "endsolid name". Binary headers often start with "solid" as well, so a
-// file is binary when its size matches its triangle count, or when it does
-// not read as "solid" followed by a "facet" or "endsolid" line.
+// file is binary when its size matches its triangle count, or when its first
+// 64 KiB do not read as "solid" followed by a "facet" or "endsolid" line.
+//
+// A binary file is streamed: its triangles are read in blocks, and with
+// welding each corner goes straight to its vertex, so that a soup takes
+// memory for its distinct vertices and the triangles that welding keeps.
 #include <cstring>
 #include <limits>
+#include <optional>
 
 #include "io/io_internal.h"
 
@@ -36,14 +41,58 @@ float loadFloat(const uint8_t* bytes) {
   return value;
 }
 
-bool sizeMatchesBinary(const uint8_t* data, size_t size) {
-  if (size < kStlPrefixBytes) return false;
-  const uint64_t count = loadUint32(data + kStlHeaderBytes);
+// The vertices and triangles of a soup: every corner is a new vertex, or
+// with welding the first vertex with its position bits; a welded triangle
+// left with a repeated vertex is dropped (the encoder would drop it too).
+class Soup {
+ public:
+  Soup(Complex& out, bool weld) : out_(out) {
+    if (weld) welder_.emplace(out.positions);
+  }
+
+  // Room for `triangles` triangles of three new corners each; welded soups
+  // grow as their vertices turn out to be distinct.
+  void reserve(uint64_t triangles) {
+    if (welder_) return;
+    out_.positions.reserve(9 * triangles);
+    out_.triangles.reserve(3 * triangles);
+  }
+
+  uint32_t corner(const float* xyz) {
+    ++corners_;
+    if (welder_) return welder_->vertexAt(xyz);
+    out_.positions.insert(out_.positions.end(), xyz, xyz + 3);
+    return static_cast<uint32_t>(out_.vertexCount() - 1);
+  }
+
+  // A facet of `size` corners, split into a fan of triangles.
+  void facet(const uint32_t* corners, size_t size) {
+    const size_t first = out_.triangles.size();
+    split_.append(corners, size, out_.triangles);
+    if (welder_) dropped_ += dropRepeated(out_.triangles, 3, first);
+  }
+
+  void addNotes(Notes& notes) const {
+    split_.addNote(notes);
+    if (welder_) addWeldNotes(notes, corners_, out_.vertexCount(), dropped_);
+  }
+
+ private:
+  Complex& out_;
+  std::optional<Welder> welder_;
+  size_t corners_ = 0;
+  size_t dropped_ = 0;
+  PolygonSplit split_;
+};
+
+bool sizeMatchesBinary(Bytes head, uint64_t size) {
+  if (head.size < kStlPrefixBytes) return false;
+  const uint64_t count = loadUint32(head.data + kStlHeaderBytes);
   return size - kStlPrefixBytes == count * kStlTriangleBytes;
 }
 
-bool looksAscii(const uint8_t* data, size_t size) {
-  TextScanner scanner(data, size);
+bool looksAscii(Bytes head) {
+  TextScanner scanner(head.data, head.size);
   std::string_view token;
   if (!scanner.nextContentLine() || !scanner.nextToken(token) ||
       !equalsIgnoringCase(token, "solid")) {
@@ -55,15 +104,16 @@ bool looksAscii(const uint8_t* data, size_t size) {
          equalsIgnoringCase(token, "endsolid");
 }
 
-Status readBinary(const uint8_t* data, size_t size, Complex& out,
-                  Notes& notes) {
-  if (size < kStlPrefixBytes) {
+// The triangle count, checked against the size before anything is
+// allocated or read past the prefix.
+Status readBinaryCount(Bytes head, uint64_t size, uint64_t& count) {
+  if (size < kStlPrefixBytes || head.size < kStlPrefixBytes) {
     return inputError(
         "not an STL file: " + std::to_string(size) +
         " bytes are too few for the 84 bytes that start a binary STL, and "
         "the text is not ascii STL ('solid' followed by 'facet' lines)");
   }
-  const uint64_t count = loadUint32(data + kStlHeaderBytes);
+  count = loadUint32(head.data + kStlHeaderBytes);
   const uint64_t needed = kStlPrefixBytes + count * kStlTriangleBytes;
   if (size < needed) {
     return inputError("binary STL declares " + std::to_string(count) +
@@ -76,29 +126,49 @@ Status readBinary(const uint8_t* data, size_t size, Complex& out,
                       " triangles, more vertices than 32-bit indices can "
                       "address");
   }
-  out.positions.reserve(9 * count);
-  out.triangles.reserve(3 * count);
+  return Status::success();
+}
+
+Status readBinary(Input& input, uint64_t size, Complex& out, Notes& notes,
+                  bool weld) {
+  uint64_t count = 0;
+  if (Status status = readBinaryCount(input.head(), size, count);
+      !status.ok()) {
+    return status;
+  }
+  Soup soup(out, weld);
+  soup.reserve(count);
+  ByteStream bytes = input.stream(kStlPrefixBytes);
   size_t withAttribute = 0;
   for (uint64_t t = 0; t < count; ++t) {
-    const uint8_t* triangle = data + kStlPrefixBytes + t * kStlTriangleBytes;
-    for (size_t k = 0; k < 9; ++k) {  // past the 3 floats of the normal
-      out.positions.push_back(loadFloat(triangle + 12 + 4 * k));
+    const uint8_t* triangle = bytes.take(kStlTriangleBytes);
+    if (triangle == nullptr) {
+      return inputError("binary STL ends inside triangle " +
+                        std::to_string(t) + " (truncated file)");
     }
-    const uint32_t base = static_cast<uint32_t>(3 * t);
-    out.triangles.insert(out.triangles.end(), {base, base + 1, base + 2});
+    uint32_t corners[3];
+    for (size_t k = 0; k < 3; ++k) {  // past the 3 floats of the normal
+      float xyz[3];
+      for (size_t axis = 0; axis < 3; ++axis) {
+        xyz[axis] = loadFloat(triangle + 12 * (k + 1) + 4 * axis);
+      }
+      corners[k] = soup.corner(xyz);
+    }
+    soup.facet(corners, 3);
     withAttribute += (triangle[48] | triangle[49]) != 0;
   }
   addCountNote(notes, "ignored the attribute values (often a colour) of ",
                withAttribute, " triangles");
-  addCountNote(notes, "ignored ", size - needed,
+  addCountNote(notes, "ignored ", bytes.remaining(),
                " bytes after the triangles of the binary STL");
+  soup.addNotes(notes);
   return Status::success();
 }
 
 class AsciiStl {
  public:
-  AsciiStl(const uint8_t* data, size_t size, Complex& out)
-      : scanner_(data, size), out_(out) {}
+  AsciiStl(Bytes text, Complex& out, bool weld)
+      : scanner_(text.data, text.size), out_(out), soup_(out, weld) {}
 
   Status read(Notes& notes) {
     std::string_view token;
@@ -125,7 +195,7 @@ class AsciiStl {
       notes.push_back("the ascii STL ends without 'endsolid' (truncated "
                       "file?)");
     }
-    split_.addNote(notes);
+    soup_.addNotes(notes);
     return Status::success();
   }
 
@@ -203,15 +273,14 @@ class AsciiStl {
           return status;
         }
       }
-      polygon_.push_back(static_cast<uint32_t>(out_.vertexCount()));
-      out_.positions.insert(out_.positions.end(), xyz, xyz + 3);
+      polygon_.push_back(soup_.corner(xyz));
     }
     if (polygon_.size() < 3) {
       return facetError("has " + std::to_string(polygon_.size()) +
                         " vertices, needs 3");
     }
     if (Status status = expect("endfacet"); !status.ok()) return status;
-    split_.append(polygon_.data(), polygon_.size(), out_.triangles);
+    soup_.facet(polygon_.data(), polygon_.size());
     return Status::success();
   }
 
@@ -219,16 +288,18 @@ class AsciiStl {
   Complex& out_;
   size_t facets_ = 0;
   std::vector<uint32_t> polygon_;  // vertices of one facet, reused
-  PolygonSplit split_;
+  Soup soup_;
 };
 
 }  // namespace
 
-Status readStl(const uint8_t* data, size_t size, Complex& out, Notes& notes) {
-  if (!sizeMatchesBinary(data, size) && looksAscii(data, size)) {
-    return AsciiStl(data, size, out).read(notes);
+Status readStl(Input& input, Complex& out, Notes& notes, bool weld) {
+  const Bytes head = input.head();
+  const uint64_t size = input.size();
+  if (!sizeMatchesBinary(head, size) && looksAscii(head)) {
+    return AsciiStl(input.whole(), out, weld).read(notes);
   }
-  return readBinary(data, size, out, notes);
+  return readBinary(input, size, out, notes, weld);
 }
 
 }  // namespace kdmesh::io::detail

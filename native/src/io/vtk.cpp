@@ -490,7 +490,7 @@ class VtkReader {
       case kTriangleStrip: case kPolygon: minimum = 3; break;
       case kPixel: case kQuad: case kTetra: minimum = maximum = 4; break;
       default:
-        ++skippedTypes_[type];
+        countSkipped(type);
         return Status::success();
     }
     if (n < minimum || (maximum != 0 && n > maximum)) {
@@ -589,18 +589,35 @@ class VtkReader {
     return Status::success();
   }
 
+  // The note names a few skipped types; a file cannot make it (or the
+  // map) grow with a new type in every cell.
+  void countSkipped(int64_t type) {
+    constexpr size_t kNamedTypes = 16;
+    const auto named = skippedTypes_.find(type);
+    if (named != skippedTypes_.end()) {
+      ++named->second;
+    } else if (skippedTypes_.size() < kNamedTypes) {
+      skippedTypes_.emplace(type, 1);
+    } else {
+      ++skippedOthers_;
+    }
+  }
+
   void addNotes(Notes& notes) const {
     if (doubleCoordinates_) {
       notes.push_back("coordinates stored as double were rounded to float32");
     }
     split_.addNote(notes);
     if (!skippedTypes_.empty()) {
-      size_t total = 0;
+      size_t total = skippedOthers_;
       std::string types;
       for (const auto& [type, count] : skippedTypes_) {
         total += count;
         types += (types.empty() ? "" : ", ") + std::to_string(type) + " x" +
                  std::to_string(count);
+      }
+      if (skippedOthers_ > 0) {
+        types += ", other types x" + std::to_string(skippedOthers_);
       }
       notes.push_back("skipped " + std::to_string(total) +
                       " cells that are neither simplices nor polygons (VTK "
@@ -619,7 +636,8 @@ class VtkReader {
   bool doubleCoordinates_ = false;
   Cells cells_;
   PolygonSplit split_;
-  std::map<int64_t, size_t> skippedTypes_;
+  std::map<int64_t, size_t> skippedTypes_;  // at most 16 types named
+  size_t skippedOthers_ = 0;                // cells of further types
   size_t fields_ = 0;
 };
 

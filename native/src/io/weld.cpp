@@ -1,15 +1,21 @@
 // ReadOptions::weld: vertices with bit-identical positions become one vertex.
-#include <algorithm>
-#include <array>
 #include <cstring>
-#include <numeric>
+#include <random>
+#include <string>
+#include <unordered_map>
 
 #include "io/io_internal.h"
 
 namespace kdmesh::io::detail {
 namespace {
 
-using Bits3 = std::array<uint32_t, 3>;
+// Spreads one random seed over the hash's four multipliers.
+uint64_t splitMix64(uint64_t& state) {
+  uint64_t z = (state += 0x9e3779b97f4a7c15u);
+  z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9u;
+  z = (z ^ (z >> 27)) * 0x94d049bb133111ebu;
+  return z ^ (z >> 31);
+}
 
 bool hasRepeatedVertex(const uint32_t* simplex, size_t arity) {
   for (size_t i = 0; i < arity; ++i) {
@@ -20,16 +26,158 @@ bool hasRepeatedVertex(const uint32_t* simplex, size_t arity) {
   return false;
 }
 
-// Renumbers `indices` and counts the simplices left with a repeated vertex.
+// Renumbers `indices` and drops the simplices left with a repeated vertex;
+// returns how many it dropped.
 size_t remap(std::vector<uint32_t>& indices, size_t arity,
              const std::vector<uint32_t>& newIndex) {
   for (uint32_t& index : indices) index = newIndex[index];
-  size_t degenerate = 0;
-  if (arity < 2) return 0;
-  for (size_t i = 0; i + arity <= indices.size(); i += arity) {
-    degenerate += hasRepeatedVertex(&indices[i], arity);
+  return arity < 2 ? 0 : dropRepeated(indices, arity);
+}
+
+}  // namespace
+
+// ---------------------------------------------------------------------------
+// Welder
+// ---------------------------------------------------------------------------
+
+Welder::Welder(std::vector<float>& positions) : positions_(positions) {
+  std::random_device device;
+  uint64_t seed = uint64_t{device()} << 32 | device();
+  for (uint64_t& multiplier : multipliers_) multiplier = splitMix64(seed);
+  grow();
+}
+
+size_t Welder::slotOf(const uint32_t* bits) const {
+  const uint64_t sum = multipliers_[0] + multipliers_[1] * bits[0] +
+                       multipliers_[2] * bits[1] + multipliers_[3] * bits[2];
+  return static_cast<size_t>(sum >> shift_);
+}
+
+// Doubles the table (at most half full, so that probes stay short) and
+// enters every vertex again.
+void Welder::grow() {
+  constexpr int kFirstBits = 10;
+  const int bits = slots_.empty() ? kFirstBits : 64 - shift_ + 1;
+  shift_ = 64 - bits;
+  slots_.assign(size_t{1} << bits, kEmpty);
+  const size_t mask = slots_.size() - 1;
+  const size_t count = positions_.size() / 3;
+  for (size_t v = 0; v < count; ++v) {
+    uint32_t bits[3];
+    std::memcpy(bits, &positions_[3 * v], sizeof bits);
+    size_t slot = slotOf(bits);
+    while (slots_[slot] != kEmpty) slot = (slot + 1) & mask;
+    slots_[slot] = static_cast<uint32_t>(v);
   }
-  return degenerate;
+}
+
+uint32_t Welder::vertexAt(const float* xyz) {
+  const size_t count = positions_.size() / 3;
+  if (2 * (count + 1) > slots_.size()) grow();
+  uint32_t bits[3];
+  std::memcpy(bits, xyz, sizeof bits);
+  const size_t mask = slots_.size() - 1;
+  for (size_t slot = slotOf(bits);; slot = (slot + 1) & mask) {
+    const uint32_t v = slots_[slot];
+    if (v == kEmpty) {
+      slots_[slot] = static_cast<uint32_t>(count);
+      positions_.insert(positions_.end(), xyz, xyz + 3);
+      return static_cast<uint32_t>(count);
+    }
+    if (std::memcmp(&positions_[3 * size_t{v}], bits, sizeof bits) == 0) {
+      return v;
+    }
+  }
+}
+
+// ---------------------------------------------------------------------------
+// Simplices and notes
+// ---------------------------------------------------------------------------
+
+namespace {
+
+// Replaces `positions` by the welded vertices; returns the new index of
+// every old vertex.
+std::vector<uint32_t> weldPositions(std::vector<float>& positions) {
+  std::vector<float> welded;
+  Welder welder(welded);
+  std::vector<uint32_t> newIndex(positions.size() / 3);
+  for (size_t v = 0; v < newIndex.size(); ++v) {
+    newIndex[v] = welder.vertexAt(&positions[3 * v]);
+  }
+  positions.swap(welded);
+  return newIndex;
+}
+
+}  // namespace
+
+size_t dropRepeated(std::vector<uint32_t>& indices, size_t arity,
+                    size_t first) {
+  size_t kept = first;
+  for (size_t i = first; i + arity <= indices.size(); i += arity) {
+    if (hasRepeatedVertex(&indices[i], arity)) continue;
+    std::memmove(&indices[kept], &indices[i], arity * sizeof(uint32_t));
+    kept += arity;
+  }
+  const size_t dropped = (indices.size() - kept) / arity;
+  indices.resize(kept);
+  return dropped;
+}
+
+void addWeldNotes(Notes& notes, size_t before, size_t after, size_t dropped) {
+  if (after < before) {
+    notes.push_back("welded " + std::to_string(before - after) +
+                    " vertices with bit-identical positions into others (" +
+                    std::to_string(before) + " -> " + std::to_string(after) +
+                    " vertices)");
+  }
+  addCountNote(notes, "dropped ", dropped,
+               " simplices that welding left with a repeated vertex");
+}
+
+namespace {
+
+// With vertex attributes: vertices become one only if their positions and
+// every attribute's values are bit-identical (a seam's vertices stay
+// apart). Replaces the positions and values by the welded vertices'.
+std::vector<uint32_t> weldVerticesAndValues(Complex& complex) {
+  const size_t n = complex.vertexCount();
+  // The hash is seeded at random, so that no input can make it collide on purpose.
+  std::random_device device;
+  uint64_t seed = uint64_t{device()} << 32 | device();
+  const uint64_t multiplier = splitMix64(seed) | 1;
+  struct Hash {
+    uint64_t multiplier;
+    size_t operator()(const std::string& key) const {
+      uint64_t h = multiplier;
+      for (const char c : key) h = (h ^ uint8_t(c)) * multiplier;
+      return size_t(h ^ (h >> 29));
+    }
+  };
+  std::unordered_map<std::string, uint32_t, Hash> seen(16, Hash{multiplier});
+  std::vector<uint32_t> newIndex(n);
+  std::vector<uint32_t> kept;
+  std::string key;
+  for (size_t v = 0; v < n; ++v) {
+    key.assign(reinterpret_cast<const char*>(&complex.positions[3 * v]), 12);
+    for (const VertexAttribute& a : complex.attributes)
+      key.append(reinterpret_cast<const char*>(&a.values[v * a.valueBytes()]), a.valueBytes());
+    const auto [at, inserted] = seen.emplace(key, uint32_t(kept.size()));
+    if (inserted) kept.push_back(uint32_t(v));
+    newIndex[v] = at->second;
+  }
+  std::vector<float> positions;
+  positions.reserve(kept.size() * 3);
+  for (const uint32_t v : kept) positions.insert(positions.end(), &complex.positions[3 * v], &complex.positions[3 * v] + 3);
+  complex.positions.swap(positions);
+  for (VertexAttribute& a : complex.attributes) {
+    std::vector<uint8_t> values;
+    values.reserve(kept.size() * a.valueBytes());
+    for (const uint32_t v : kept)
+      values.insert(values.end(), &a.values[v * a.valueBytes()], &a.values[v * a.valueBytes()] + a.valueBytes());
+    a.values.swap(values);
+  }
+  return newIndex;
 }
 
 }  // namespace
@@ -37,47 +185,14 @@ size_t remap(std::vector<uint32_t>& indices, size_t arity,
 void weldVertices(Complex& complex, Notes& notes) {
   const size_t n = complex.vertexCount();
   if (n < 2) return;
-  std::vector<Bits3> bits(n);
-  for (size_t v = 0; v < n; ++v) {
-    std::memcpy(bits[v].data(), &complex.positions[3 * v], sizeof(Bits3));
-  }
-  // Equal positions end up next to each other, the lowest index first.
-  std::vector<uint32_t> order(n);
-  std::iota(order.begin(), order.end(), 0u);
-  std::sort(order.begin(), order.end(), [&bits](uint32_t a, uint32_t b) {
-    return bits[a] != bits[b] ? bits[a] < bits[b] : a < b;
-  });
-  std::vector<uint32_t> first(n);  // the lowest index with the same bits
-  for (size_t i = 0; i < n; ++i) {
-    const uint32_t v = order[i];
-    first[v] = i > 0 && bits[order[i - 1]] == bits[v] ? first[order[i - 1]] : v;
-  }
-  // Kept vertices in their original order; first[v] <= v, so the positions
-  // move down in place.
-  std::vector<uint32_t> newIndex(n);
-  uint32_t kept = 0;
-  for (size_t v = 0; v < n; ++v) {
-    if (first[v] != v) {
-      newIndex[v] = newIndex[first[v]];
-      continue;
-    }
-    newIndex[v] = kept;
-    std::memmove(&complex.positions[3 * size_t{kept}],
-                 &complex.positions[3 * v], 3 * sizeof(float));
-    ++kept;
-  }
-  if (kept == n) return;
-  complex.positions.resize(3 * size_t{kept});
+  const std::vector<uint32_t> newIndex =
+      complex.attributes.empty() ? weldPositions(complex.positions) : weldVerticesAndValues(complex);
+  if (complex.vertexCount() == n) return;
   remap(complex.points, 1, newIndex);
-  const size_t degenerate = remap(complex.edges, 2, newIndex) +
-                            remap(complex.triangles, 3, newIndex) +
-                            remap(complex.tetrahedra, 4, newIndex);
-  notes.push_back("welded " + std::to_string(n - kept) +
-                  " vertices with bit-identical positions into others (" +
-                  std::to_string(n) + " -> " + std::to_string(kept) +
-                  " vertices)");
-  addCountNote(notes, "after welding, ", degenerate,
-               " simplices have a repeated vertex (the encoder drops them)");
+  const size_t dropped = remap(complex.edges, 2, newIndex) +
+                         remap(complex.triangles, 3, newIndex) +
+                         remap(complex.tetrahedra, 4, newIndex);
+  addWeldNotes(notes, n, complex.vertexCount(), dropped);
 }
 
 }  // namespace kdmesh::io::detail
