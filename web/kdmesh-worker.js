@@ -12,6 +12,11 @@
 //               {type: 'next'} (the page is ready for a snapshot)
 // Messages out: {type: 'header', header}, {type: 'snapshot', model} (the
 //               last one has model.complete), {type: 'error', code, message}
+//
+// A snapshot's arrays are sized for the final model, so that the page can
+// adopt them as GPU buffer storage: positions, normals and each vertex
+// attribute (model.attributes, name -> {array, itemSize}) in their own
+// storage, the lists of simplices packed (see pack()).
 import { createDecoder, setWasmSource } from './kdmesh.js';
 
 let wasmSet = false;
@@ -36,8 +41,9 @@ function boundaryOfTetrahedra(tetrahedra) {
   return out;
 }
 
-// Area-weighted vertex normals of the triangles: computed here, off the
-// page's main thread, and sent with the snapshot; in storage as large as the
+// Area-weighted vertex normals of the triangles, for streams without normals
+// of their own (see streamNormals()): computed here, off the page's main
+// thread, and sent with the snapshot; in storage as large as the
 // positions' (see pack()).
 function vertexNormals(positions, triangles) {
   const normals = new Float32Array(positions.buffer.byteLength / 4).subarray(0, positions.length);
@@ -59,6 +65,14 @@ function vertexNormals(positions, triangles) {
     normals[i + 2] /= length;
   }
   return normals;
+}
+
+// The stream's own normals, when it has a 'normal' attribute of three
+// float32 components: they stand for the input's, which triangles of a
+// coarse level would only approximate. Else undefined.
+function streamNormals(attributes) {
+  const normal = attributes.normal;
+  return normal && normal.itemSize === 3 && normal.array instanceof Float32Array ? normal.array : undefined;
 }
 
 // Lists drawn together, one after the other in one new array of at least
@@ -134,11 +148,16 @@ function sendSnapshot() {
     2 * (edgeCount + (wireframe ? 6 * tetrahedronCount : 0)));
   const [triangles, boundaryInPlace] = pack(Uint32Array, [live.triangles, boundary], 3 * (triangleCount + 4 * tetrahedronCount));
   const drawnTriangles = new Uint32Array(triangles.buffer, 0, triangles.length + boundary.length);  // both lists
+  // Each vertex attribute in storage of its own, sized like the positions'.
+  const attributes = {};
+  for (const [name, { array, itemSize }] of Object.entries(live.attributes))
+    attributes[name] = { array: pack(array.constructor, [array], vertexCount * itemSize)[0], itemSize };
   const model = {
-    ...live, positions, points, edges, triangles, tetrahedra: live.tetrahedra.slice(),
+    ...live, positions, points, edges, triangles, tetrahedra: live.tetrahedra.slice(), attributes,
     boundary: boundaryInPlace, tetrahedronEdges: tetrahedronEdgesInPlace,
     bounds: bounds(positions),
-    normals: drawnTriangles.length ? vertexNormals(positions, drawnTriangles) : new Float32Array(0),
+    normals: streamNormals(attributes) ??
+      (drawnTriangles.length ? vertexNormals(positions, drawnTriangles) : new Float32Array(0)),
     parents: geomorph ? decoder.parents() : new Uint32Array(0),
     progress: decoder.progress,
   };
@@ -146,7 +165,8 @@ function sendSnapshot() {
   job.changed = false;
   job.decodeMs = 0;
   job.handOverMs = performance.now() - began;
-  const buffers = [positions, points, edges, triangles, model.tetrahedra, model.normals, model.parents]
+  const buffers = [positions, points, edges, triangles, model.tetrahedra, model.normals, model.parents,
+    ...Object.values(attributes).map((a) => a.array)]
     .map((a) => a.buffer).filter((b, i, all) => b.byteLength && all.indexOf(b) === i);
   postMessage({ type: 'snapshot', model }, buffers);
   if (model.complete) end();

@@ -13,6 +13,7 @@ export interface StreamedModel extends Model {
   tetrahedronEdges: Uint32Array;
   /** [minX, minY, minZ, maxX, maxY, maxZ] */
   bounds: number[];
+  /** The stream's 'normal' attribute when it is three float32, else computed from the triangles (empty without any). */
   normals: Float32Array;
   /** With geomorph: the vertex each vertex was split from. */
   parents: Uint32Array;
@@ -67,8 +68,15 @@ export class GpuFence {
   set(): void;
 }
 
+/**
+ * Loads .kdm streams into three.js. The stream's vertex attributes become geometry attributes of
+ * the same names, refined in place: 'color' (integer types normalized), 'normal' (the stream's
+ * instead of computed ones), 'uv', and any other under its own name. A model with a 'color' draws
+ * the loader's own materials with vertexColors; materials the page supplies need it set by the page.
+ */
 export class KDMeshLoader extends Loader<Group> {
   constructor(manager?: LoadingManager);
+  /** Shared by every model the loader loads; change or replace them before loading. */
   materials: { surface: MeshStandardMaterial; lines: LineBasicMaterial; points: PointsMaterial };
   uploadBytesPerSlice: number;
   workerLimit: number;

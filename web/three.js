@@ -15,7 +15,11 @@
 // loadProgressive/load/parse holds a Mesh (triangles, and the boundary of
 // tetrahedra), a LineSegments (edges) and a Points (isolated vertices),
 // drawn with the loader's `materials` (shared by every model it loads;
-// change or replace them before loading). `await
+// change or replace them before loading). The stream's vertex attributes
+// become geometry attributes of the same names ('color', 'normal', 'uv',
+// and any other under its own name, see vertexAttributesOf()), refined in
+// place like the positions; a model with a 'color' draws with vertex
+// colours (materials the page supplies need vertexColors set). `await
 // loader.prepareRenderer(renderer, camera, scene)` before streaming keeps
 // the first refinements from blocking the page.
 import {
@@ -33,23 +37,46 @@ const nextFrame = () =>
 // The whole array behind a view from the worker.
 const storageOf = (view) => new view.constructor(view.buffer);
 
-// Makes `storage` the geometry's attribute `name`, without a copy: the
-// worker sizes storage for the final model (from the header) and hands it
-// over, and an attribute whose storage keeps its size keeps its GPU buffer.
-function adoptAttribute(geometry, name, storage, itemSize) {
-  let attribute = name === 'index' ? geometry.index : geometry.getAttribute(name);
+// adoptAttribute's name for the geometry's index (a vertex attribute of the
+// stream may be called 'index').
+const INDEX = null;
+
+// Makes `storage` the geometry's attribute `name` (or its index), without a
+// copy: the worker sizes storage for the final model (from the header) and
+// hands it over, and an attribute whose storage keeps its size keeps its GPU
+// buffer.
+function adoptAttribute(geometry, name, storage, itemSize, normalized = false) {
+  let attribute = name === INDEX ? geometry.index : geometry.getAttribute(name);
   if (attribute && attribute.array.byteLength === storage.byteLength) {
     attribute.array = storage;
   } else {
-    attribute = new BufferAttribute(storage, itemSize);
-    if (name === 'index') geometry.setIndex(attribute);
+    attribute = new BufferAttribute(storage, itemSize, normalized);
+    if (name === INDEX) geometry.setIndex(attribute);
     else geometry.setAttribute(name, attribute);
   }
   return attribute;
 }
 
+// The geometry attributes of a level besides 'position', as
+// { name, array, itemSize, normalized }: 'normal' from model.normals (the
+// stream's own normals or, without them, the worker's), then the stream's
+// vertex attributes under their own names ('color', 'uv', ...), as three.js's
+// shaders and loaders name them. A 'color' of an integer type is normalized
+// (0-255 is 0-1 for uint8). Attributes named 'position', and a 'normal' the
+// worker did not take as the normals (not three float32), would replace the
+// loader's own: they stay in the model's `attributes` only.
+function vertexAttributesOf(model) {
+  const out = [];
+  if (model.normals.length) out.push({ name: 'normal', array: model.normals, itemSize: 3, normalized: false });
+  for (const [name, { array, itemSize }] of Object.entries(model.attributes)) {
+    if (name === 'position' || name === 'normal') continue;
+    out.push({ name, array, itemSize, normalized: name === 'color' && !(array instanceof Float32Array) });
+  }
+  return out;
+}
+
 // One set of geometries for a model's three objects (surface, lines,
-// points; they share the position attribute). A model has two: the level on
+// points; they share the vertex attributes). A model has two: the level on
 // screen is drawn from one while the next level goes to the GPU in the other.
 class GeometrySet {
   constructor() {
@@ -59,8 +86,8 @@ class GeometrySet {
 
   // Takes a level's arrays; their first `used` elements are to go to the GPU
   // (see mark()).
-  stage(name, geometryIndex, storage, used, itemSize) {
-    const attribute = adoptAttribute(this.geometries[geometryIndex], name, storage, itemSize);
+  stage(name, geometryIndex, storage, used, itemSize, normalized) {
+    const attribute = adoptAttribute(this.geometries[geometryIndex], name, storage, itemSize, normalized);
     if (used > 0) this.queue.push({ attribute, marked: 0, used });
     return attribute;
   }
@@ -197,19 +224,39 @@ const listsOf = (model) => [
   [model.points, 0],
 ];
 
+// Vertex colours come as files store them, in sRGB (PLY's red, green and
+// blue), and three.js takes them as linear: `material`'s vertex shader
+// converts them, per vertex, as three.js's PLYLoader does on loading. Any
+// shader hook of `from` (the material copied) runs first.
+function decodeSrgbVertexColours(material, from) {
+  material.onBeforeCompile = (shader, renderer) => {
+    from.onBeforeCompile(shader, renderer);
+    shader.vertexShader = shader.vertexShader.replace('#include <color_vertex>', `#include <color_vertex>
+#if defined( USE_COLOR ) || defined( USE_COLOR_ALPHA )
+  vColor.rgb = mix( vColor.rgb * 0.0773993808, pow( vColor.rgb * 0.9478672986 + 0.0521327014, vec3( 2.4 ) ),
+                    vec3( greaterThan( vColor.rgb, vec3( 0.04045 ) ) ) );
+#endif`);
+  };
+  material.customProgramCacheKey = () => `${from.customProgramCacheKey()}|srgb-vertex-colours`;
+}
+
 // A model as a THREE.Group of three objects (surface, lines, points) with
 // two sets of geometries: the level on screen is drawn from `front`; the
 // next one is staged in `back` and, on renderers passed to
 // prepareRenderer(), uploaded in slices by `uploaders`. With
 // options.geomorph, every vertex glides from where its ancestor was drawn at
-// the previous level to its new position over a few frames.
+// the previous level to its new position over a few frames. A model with
+// vertex colours draws with the materials `vertexColoured(material)` gives
+// for the group's.
 class GroupView {
-  constructor(group, uploads, options) {
+  constructor(group, uploads, options, vertexColoured) {
     this.object = group;
     this.objects = group.children;
     this.uploads = uploads;
     this.uploaders = uploads?.createUploaders() ?? [];
     this.options = options;
+    this.vertexColoured = vertexColoured;
+    this.coloured = false;  // the objects have their vertex-coloured materials
     this.front = new GeometrySet();
     this.back = new GeometrySet();
     this.objects.forEach((object, i) => {
@@ -268,13 +315,18 @@ class GroupView {
       this.morphTarget = { start: drawn.slice(0, model.positions.length), positions: model.positions, count: model.vertexCount };
     }
     if (options.geomorph) this.previous = { positions: model.positions, count: model.vertexCount };
-    const position = back.stage('position', 0, drawn, model.positions.length, 3);
-    back.geometries[1].setAttribute('position', position);
-    back.geometries[2].setAttribute('position', position);
-    // Normals come from the worker. On the final dragon (871k triangles,
-    // Node 20) the worker's loop takes 90 ms and three.js's
-    // computeVertexNormals 140 ms, which would block the main thread.
-    if (model.normals.length) back.stage('normal', 0, storageOf(model.normals), model.normals.length, 3);
+    // The three objects share each vertex attribute: one GPU buffer apiece.
+    const share = (name, attribute) => {
+      back.geometries[1].setAttribute(name, attribute);
+      back.geometries[2].setAttribute(name, attribute);
+    };
+    share('position', back.stage('position', 0, drawn, model.positions.length, 3));
+    // Normals come from the worker (the stream's, or computed there: on the
+    // final dragon, 871k triangles, Node 20, the worker's loop takes 90 ms
+    // and three.js's computeVertexNormals 140 ms, which would block the
+    // main thread).
+    for (const { name, array, itemSize, normalized } of vertexAttributesOf(model))
+      share(name, back.stage(name, 0, storageOf(array), array.length, itemSize, normalized));
   }
 
   #stageLists(model) {
@@ -284,7 +336,7 @@ class GroupView {
     const sphere = box.getBoundingSphere(new Sphere());
     listsOf(model).forEach(([first, more], i) => {
       const count = first.length + more;
-      if (count) this.back.stage('index', i, storageOf(first), count, 1);
+      if (count) this.back.stage(INDEX, i, storageOf(first), count, 1);
       const geometry = this.back.geometries[i];
       geometry.boundingBox = box.clone();
       geometry.boundingSphere = sphere.clone();
@@ -300,6 +352,10 @@ class GroupView {
       this.objects[i].geometry = this.front.geometries[i];
       this.objects[i].visible = count > 0;
     });
+    if (model.attributes.color && !this.coloured) {
+      this.coloured = true;
+      for (const object of this.objects) object.material = this.vertexColoured(object.material);
+    }
     const position = this.front.geometries[0].getAttribute('position');
     if (this.morphTarget) this.#morph(position, this.morphTarget);
     else this.morphId += 1;  // a level drawn at once ends any morph in flight
@@ -345,19 +401,20 @@ class GeometryView {
     await nextFrame();
     if (stopped()) return false;
     const geometry = this.object;
-    const update = (name, storage, used, itemSize) => {
-      const attribute = adoptAttribute(geometry, name, storage, itemSize);
+    const update = (name, storage, used, itemSize, normalized) => {
+      const attribute = adoptAttribute(geometry, name, storage, itemSize, normalized);
       attribute.clearUpdateRanges();
       attribute.addUpdateRange(0, used);
       attribute.needsUpdate = true;
     };
     update('position', storageOf(model.positions), model.positions.length, 3);
-    if (model.normals.length) update('normal', storageOf(model.normals), model.normals.length, 3);
+    for (const { name, array, itemSize, normalized } of vertexAttributesOf(model))
+      update(name, storageOf(array), array.length, itemSize, normalized);
     let count = model.vertexCount;
     if (this.list >= 0) {
       const [first, more] = listsOf(model)[this.list];
       count = first.length + more;
-      if (count) update('index', storageOf(first), count, 1);
+      if (count) update(INDEX, storageOf(first), count, 1);
     }
     geometry.setDrawRange(0, count);
     geometry.boundingBox = new Box3().setFromArray(model.bounds);
@@ -376,6 +433,8 @@ export class KDMeshLoader extends Loader {
   #wasm = null;         // Promise of the compiled WebAssembly module
   #workerScript = null; // Promise of { url, options } to start workers with
   #disposed = false;
+  #ownMaterials;        // the materials the constructor made
+  #colouredMaterials = new Map();  // one of those -> its copy for vertex colours (see #vertexColoured)
 
   constructor(manager) {
     super(manager);
@@ -397,6 +456,7 @@ export class KDMeshLoader extends Loader {
       lines: new LineBasicMaterial({ color: 0x33475b }),
       points: new PointsMaterial({ color: 0x1f6feb, size: 2, sizeAttenuation: false }),
     };
+    this.#ownMaterials = new Set(Object.values(this.materials));
   }
 
   /** Workers decoding a stream now. */
@@ -407,10 +467,10 @@ export class KDMeshLoader extends Loader {
   /**
    * Prepares `renderer` to draw the loader's models in `scene` (whose lights
    * decide the shaders) without blocking the page, as measured in Chromium:
-   *  - compiles the materials' shaders and draws a sample of each kind of
-   *    object once, hidden behind `camera` (under software WebGL the first
-   *    draw of a model otherwise took 130-230 ms, even with the shaders
-   *    compiled);
+   *  - compiles the materials' shaders, and those of their vertex-coloured
+   *    copies, and draws a sample of each kind of object with each once,
+   *    hidden behind `camera` (under software WebGL the first draw of a
+   *    model otherwise took 130-230 ms, even with the shaders compiled);
    *  - fills the GPU buffers of models as their content grows, not at once
    *    (see createBuffersFromUsedBytes), and uploads a level in slices of
    *    `uploadBytesPerSlice` between frames, while the previous level stays
@@ -431,22 +491,50 @@ export class KDMeshLoader extends Loader {
     surface.geometry.setIndex(new BufferAttribute(new Uint32Array([0, 1, 2]), 1));
     lines.geometry.setIndex(new BufferAttribute(new Uint32Array([0, 1]), 1));
     points.geometry.setIndex(new BufferAttribute(new Uint32Array([0]), 1));
+    const white = new BufferAttribute(new Uint8Array(9).fill(255), 3, true);
     for (const object of sample.children) {
       object.geometry.setAttribute('position', corners);
+      object.geometry.setAttribute('color', white);
       object.frustumCulled = false;
     }
+    // The same objects with the materials of models with vertex colours.
+    const coloured = sample.clone();
+    for (const object of coloured.children) object.material = this.#vertexColoured(object.material);
+    const samples = new Group().add(sample, coloured);
     try {
-      await renderer.compileAsync(sample, camera, scene);
-      scene.add(sample);
+      await renderer.compileAsync(samples, camera, scene);
+      scene.add(samples);
       renderer.render(scene, camera);
       // The uploads' shader, compiled now too.
       const uploaders = this.uploads.createUploaders();
       uploaders.forEach((object, i) => (object.geometry = sample.children[i].geometry));
       this.uploads.run(uploaders);
     } finally {
-      scene.remove(sample);
+      scene.remove(samples);
       for (const object of sample.children) object.geometry.dispose();
     }
+  }
+
+  #groupView(group, options) {
+    return new GroupView(group, this.uploads, options, (material) => this.#vertexColoured(material));
+  }
+
+  // For a model with vertex colours: a material of the loader's own (one it
+  // made, in `materials`) gives way to its copy with vertexColors set, a
+  // white colour and sRGB vertex colours (see decodeSrgbVertexColours), so
+  // that the colours show as the file has them; the copy is made again from
+  // the material for each coloured model. A material the page put in
+  // `materials` draws as it is: the page sets its vertexColors.
+  #vertexColoured(material) {
+    if (!this.#ownMaterials.has(material)) return material;
+    let copy = this.#colouredMaterials.get(material);
+    if (copy) copy.copy(material);
+    else this.#colouredMaterials.set(material, (copy = material.clone()));
+    copy.vertexColors = true;
+    copy.color.set(0xffffff);
+    decodeSrgbVertexColours(copy, material);
+    copy.needsUpdate = true;
+    return copy;
   }
 
   // The objects of one model: their geometries are the model's own, the
@@ -516,7 +604,7 @@ export class KDMeshLoader extends Loader {
   parse(buffer, onLoad, onError) {
     const model = this.#createGroup();
     const bytes = ArrayBuffer.isView(buffer) ? new Uint8Array(buffer.buffer, buffer.byteOffset, buffer.byteLength) : new Uint8Array(buffer);
-    this.#run(null, bytes.slice(), {}, new GroupView(model, this.uploads, {}));  // the worker takes the copy
+    this.#run(null, bytes.slice(), {}, this.#groupView(model, {}));  // the worker takes the copy
     model.userData.loaded.then(() => onLoad?.(model), (error) => onError?.(error));
     return model;
   }
@@ -536,14 +624,16 @@ export class KDMeshLoader extends Loader {
    */
   loadProgressive(url, options = {}) {
     const model = this.#createGroup();
-    this.#run(url, null, options, new GroupView(model, this.uploads, options));
+    this.#run(url, null, options, this.#groupView(model, options));
     return model;
   }
 
   /**
    * Like loadProgressive, but returns one BufferGeometry, refined in place,
    * for a material and object of the page's choice (see GeometryView):
-   * geometry.userData has loaded, stats and primitive. No geomorphs.
+   * geometry.userData has loaded, stats and primitive. No geomorphs. The
+   * vertex attributes are the group's (a 'color' shows with a material
+   * whose vertexColors is set).
    */
   loadGeometry(url, options = {}) {
     const geometry = new BufferGeometry();
@@ -572,7 +662,7 @@ export class KDMeshLoader extends Loader {
     this.#idle = [];
     this.#workerScript?.then(({ url, revoke }) => revoke && URL.revokeObjectURL(url), () => {});
     this.uploads?.dispose();
-    for (const material of Object.values(this.materials)) material.dispose();
+    for (const material of [...Object.values(this.materials), ...this.#colouredMaterials.values()]) material.dispose();
     return this;
   }
 

@@ -12,6 +12,8 @@ const viewer = (window.kdmeshViewer = {
   // 'loading', 'complete' or 'error' (also when stopped).
   state: 'idle', source: null, refinements: 0, vertexCount: 0, triangleCount: 0, tetrahedronCount: 0, edgeCount: 0,
   pointCount: 0, bytesReceived: 0, bytesExpected: 0, level: 0, error: null, firstRenderMs: null,
+  // Names of the model's vertex attributes ('color' draws as vertex colours).
+  attributes: [],
   // The complete model's totals, from the stream's header.
   levelCount: 0, vertexTotal: 0,
   // Since the load began: the first and the last level drawn, and the last
@@ -47,6 +49,18 @@ const viewer = (window.kdmeshViewer = {
       ++total;
     }
     return total ? Math.max(...counts.values()) / total : 0;
+  },
+  // Pixels of a new frame where one of red, green and blue is more than
+  // 2.5 times each of the others, by that channel (for tests: vertex colours
+  // drawn as the file has them, where the default materials are grey-blue).
+  vividPixels() {
+    const data = framePixels();
+    const counts = { red: 0, green: 0, blue: 0 };
+    const names = ['red', 'green', 'blue'];
+    for (let i = 0; i < data.length; i += 4)
+      for (let c = 0; c < 3; ++c)
+        if (data[i + c] > 2.5 * data[i + (c + 1) % 3] && data[i + c] > 2.5 * data[i + (c + 2) % 3]) ++counts[names[c]];
+    return counts;
   },
   // Pixels of a new frame that differ from the background (for tests).
   modelPixels() {
@@ -213,6 +227,7 @@ function describe(stats) {
     (viewer.triangleCount ? ` · ${count(viewer.triangleCount)} triangles` : '') +
     (viewer.tetrahedronCount ? ` · ${count(viewer.tetrahedronCount)} tetrahedra` : '') +
     (viewer.edgeCount ? ` · ${count(viewer.edgeCount)} edges` : '') +
+    (viewer.attributes.length ? ` · ${viewer.attributes.join(', ')}` : '') +
     ` · ${bpv} bits/vertex${m?.complete ? '' : ' so far'}`;
 }
 
@@ -229,7 +244,7 @@ function start(load) {
   const began = (loadBegan = performance.now());
   Object.assign(viewer, {
     state: 'loading', refinements: 0, error: null, firstRenderMs: null, completeMs: null, finalRenderMs: null, bytesReceived: 0,
-    bytesExpected: 0, levelCount: 0, vertexTotal: 0, levelsSeen: [], longTasks: [],
+    bytesExpected: 0, levelCount: 0, vertexTotal: 0, levelsSeen: [], longTasks: [], attributes: [],
   });
   pendingStatus = pendingProgress = null;
   $('progress').value = $('decoded').value = 0;
@@ -259,7 +274,7 @@ function start(load) {
       Object.assign(viewer, {
         refinements: stats.refinements, vertexCount: m.vertexCount, triangleCount: m.triangles.length / 3,
         tetrahedronCount: m.tetrahedra.length / 4, edgeCount: m.edges.length / 2, pointCount: m.points.length,
-        level: m.progress.level,
+        level: m.progress.level, attributes: Object.keys(m.attributes),
       });
       if (!viewer.levelsSeen.includes(m.progress.level)) viewer.levelsSeen.push(m.progress.level);
       if (!framed) { frame(model); framed = true; }

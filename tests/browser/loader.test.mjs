@@ -1,7 +1,7 @@
 // KDMeshLoader in headless chromium, as a three.js application uses it:
 // LoadingManager events and URL handling, abort(), dispose() mid-load, the
-// worker pool's limit, the BufferGeometry result, decoder limits and a
-// WebAssembly file that cannot be fetched. Models come from the viewer's
+// worker pool's limit, the BufferGeometry result, decoder limits, a
+// WebAssembly file that cannot be fetched, and vertex attributes. Models come from the viewer's
 // dev server, paced where a load must still be running.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
@@ -13,10 +13,10 @@ import { launchChromium } from './chromium.mjs';
 import { decode } from 'kdmesh';
 import { startServer } from '../../web/server.mjs';
 import { modelChecksum } from '../../web/model-checksum.js';
-import { root, cli } from '../js/fixtures.mjs';
+import { root, cli, colouredTorus, writePly } from '../js/fixtures.mjs';
 
 const models = mkdtempSync(join(tmpdir(), 'kdmesh-loader-'));
-let server, browser, base, expected;
+let server, browser, base, expected, coloured;
 
 // A page with three.js and kdmesh/three in its import map, as the viewer has.
 const testPage = `<!doctype html><meta charset="utf-8"><link rel="icon" href="data:,">
@@ -32,6 +32,11 @@ before(async () => {
   execFileSync(cli, ['encode', join(root, 'build', 'models', 'fandisk.off'), '-o', join(models, 'fandisk.kdm'), '--bits', '12', '-q']);
   const decoded = await decode(readFileSync(join(models, 'fandisk.kdm')));
   expected = { checksum: modelChecksum(decoded), vertexCount: decoded.vertexCount, indices: decoded.triangles.length, bytes: readFileSync(join(models, 'fandisk.kdm')).length };
+  // A torus with colours, normals of its own, texture coordinates and a
+  // 'label', in several chunks.
+  writePly(join(models, 'coloured.ply'), colouredTorus());
+  execFileSync(cli, ['encode', join(models, 'coloured.ply'), '-o', join(models, 'coloured.kdm'), '--bits', '12', '--chunk-bytes', '1024', '-q']);
+  coloured = await decode(readFileSync(join(models, 'coloured.kdm')));
   server = await startServer({ port: 0, root: models, host: '127.0.0.1' });
   base = `http://127.0.0.1:${server.address().port}`;
   browser = await launchChromium();
@@ -272,6 +277,115 @@ test('an idle worker ends after workerIdleTime', async () => {
     return { right, reused, later: loader.workers.size };
   });
   assert.deepEqual(result, { right: 1, reused: 1, later: 0 });
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('vertex attributes: color, the stream\'s normals, uv and others on the geometry, refined in place, with vertex colours', async () => {
+  const { page, errors } = await openPage();
+  const result = await page.evaluate(async () => {
+    // Whether the geometry's attribute `name` starts with the level's values.
+    const holds = (geometry, name, { array }) => {
+      const drawn = geometry.getAttribute(name)?.array;
+      return Boolean(drawn) && array.every((value, i) => Object.is(drawn[i], value));
+    };
+    const describe = (attribute) => ({
+      type: attribute.array.constructor.name, itemSize: attribute.itemSize, normalized: attribute.normalized,
+      capacity: attribute.array.length,
+    });
+    const loader = new KDMeshLoader();
+    const levels = [];
+    const group = loader.loadProgressive('models/coloured.kdm?throttle=100', {
+      onRefine(model, stats) {
+        const [surface, lines, points] = model.children;
+        const { attributes } = stats.model;
+        levels.push({
+          vertices: stats.model.vertexCount,
+          names: Object.keys(attributes),
+          held: Object.entries(attributes).every(([name, attribute]) => holds(surface.geometry, name, attribute)),
+          capacities: ['color', 'normal', 'uv', 'label'].map((name) => surface.geometry.getAttribute(name).array.length),
+          shared: ['color', 'normal', 'uv', 'label'].every((name) =>
+            lines.geometry.getAttribute(name) === surface.geometry.getAttribute(name) &&
+            points.geometry.getAttribute(name) === surface.geometry.getAttribute(name)),
+        });
+      },
+    });
+    await group.userData.loaded;
+    const { geometry, material } = group.children[0];
+    const model = group.userData.stats.model;
+    const n = model.vertexCount;
+    const normals = Array.from(geometry.getAttribute('normal').array.subarray(0, 3 * n));
+    const computed = geometry.clone();
+    computed.computeVertexNormals();
+    const recomputed = Array.from(computed.getAttribute('normal').array.subarray(0, 3 * n));
+    const coloured = {
+      levels, normals, recomputed,
+      color: describe(geometry.getAttribute('color')), normal: describe(geometry.getAttribute('normal')),
+      uv: describe(geometry.getAttribute('uv')), label: describe(geometry.getAttribute('label')),
+      colors: Array.from(geometry.getAttribute('color').array.subarray(0, 3 * n)),
+      uvs: Array.from(geometry.getAttribute('uv').array.subarray(0, 2 * n)),
+      labels: Array.from(geometry.getAttribute('label').array.subarray(0, n)),
+      streamColors: Array.from(model.attributes.color.array),
+      vertexColors: group.children.map((object) => object.material.vertexColors),
+      white: material.color.getHex(),
+      loaderMaterials: Object.values(loader.materials).map((m) => m.vertexColors),
+    };
+    // A model without colours from the same loader keeps the loader's materials.
+    const plain = await loader.loadAsync('models/fandisk.kdm');
+    const uncoloured = {
+      same: plain.children.every((object, i) => object.material === Object.values(loader.materials)[i]),
+      color: plain.children[0].geometry.hasAttribute('color'),
+    };
+    // loadGeometry: the same attributes on the one geometry.
+    const single = loader.loadGeometry('models/coloured.kdm');
+    await single.userData.loaded;
+    const singleModel = single.userData.stats.model;
+    const geometryView = {
+      names: Object.keys(single.attributes).sort(),
+      held: Object.entries(singleModel.attributes).every(([name, attribute]) => holds(single, name, attribute)),
+      color: describe(single.getAttribute('color')),
+    };
+    // A material the page puts in `materials` is drawn as it is.
+    const own = new THREE.MeshBasicMaterial();
+    loader.materials.surface = own;
+    const kept = (await loader.loadAsync('models/coloured.kdm')).children[0].material;
+    loader.dispose();
+    return { coloured, uncoloured, geometryView, pageMaterial: { same: kept === own, vertexColors: kept.vertexColors } };
+  });
+  const { coloured: c } = result;
+  const n = coloured.vertexCount;
+  assert.ok(c.levels.length >= 3, `refinements: ${c.levels.length}`);
+  assert.ok(c.levels[0].vertices < n, JSON.stringify(c.levels[0]));
+  for (const level of c.levels) {
+    assert.deepEqual(level.names, ['color', 'normal', 'uv', 'label'], JSON.stringify(level));
+    assert.ok(level.held && level.shared, JSON.stringify(level));
+    // Sized for the final model from the first level on.
+    assert.deepEqual(level.capacities, [3 * n, 3 * n, 2 * n, n], JSON.stringify(level));
+  }
+  // The stream's types; colours normalized.
+  assert.deepEqual(c.color, { type: 'Uint8Array', itemSize: 3, normalized: true, capacity: 3 * n });
+  assert.deepEqual(c.normal, { type: 'Float32Array', itemSize: 3, normalized: false, capacity: 3 * n });
+  assert.deepEqual(c.uv, { type: 'Float32Array', itemSize: 2, normalized: false, capacity: 2 * n });
+  assert.deepEqual(c.label, { type: 'Int16Array', itemSize: 1, normalized: false, capacity: n });
+  // The stream's values, the normals not recomputed from the triangles.
+  assert.deepEqual(c.colors, Array.from(coloured.attributes.color.array));
+  assert.deepEqual(c.streamColors, c.colors);
+  assert.deepEqual(c.normals, Array.from(coloured.attributes.normal.array));
+  const differing = c.normals.filter((v, i) => Math.abs(v - c.recomputed[i]) > 1e-3).length;
+  assert.ok(differing > c.normals.length / 4, `${differing} of ${c.normals.length} normal components differ from computed ones`);
+  assert.deepEqual(c.uvs, Array.from(coloured.attributes.uv.array));
+  assert.deepEqual(c.labels, Array.from(coloured.attributes.label.array));
+  // Vertex colours on the model's copies of the loader's materials, white so
+  // that the colours show as they are; the loader's own stay as they were.
+  assert.deepEqual(c.vertexColors, [true, true, true]);
+  assert.equal(c.white, 0xffffff);
+  assert.deepEqual(c.loaderMaterials, [false, false, false]);
+  assert.deepEqual(result.uncoloured, { same: true, color: false });
+  assert.deepEqual(result.geometryView, {
+    names: ['color', 'label', 'normal', 'position', 'uv'], held: true,
+    color: { type: 'Uint8Array', itemSize: 3, normalized: true, capacity: 3 * n },
+  });
+  assert.deepEqual(result.pageMaterial, { same: true, vertexColors: false });
   assert.deepEqual(errors, []);
   await page.close();
 });

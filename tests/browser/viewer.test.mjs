@@ -10,7 +10,7 @@ import { launchChromium } from './chromium.mjs';
 import { decode } from 'kdmesh';
 import { startServer } from '../../web/server.mjs';
 import { modelChecksum } from '../../web/model-checksum.js';
-import { root, cli } from '../js/fixtures.mjs';
+import { root, cli, colouredTorus, writePly } from '../js/fixtures.mjs';
 
 const models = mkdtempSync(join(tmpdir(), 'kdmesh-browser-'));
 const screenshots = join(root, 'build', 'screenshots');
@@ -27,6 +27,9 @@ before(async () => {
   // at most one level per frame), and one in the default chunks.
   execFileSync(cli, ['encode', join(root, 'build', 'models', 'fandisk.off'), '-o', join(models, 'small.kdm'), '--bits', '14', '--points-only', '--chunk-bytes', '2048', '-q']);
   execFileSync(cli, ['encode', join(root, 'build', 'models', 'fandisk.off'), '-o', join(models, 'points.kdm'), '--bits', '12', '--points-only', '-q']);
+  // A torus with vertex colours, red on one side and blue on the other.
+  writePly(join(models, 'coloured.ply'), colouredTorus());
+  execFileSync(cli, ['encode', join(models, 'coloured.ply'), '-o', join(models, 'coloured.kdm'), '--bits', '12', '-q']);
   execFileSync('mkdir', ['-p', screenshots]);
   server = await startServer({ port: 0, root: models, host: '127.0.0.1' });
   base = `http://127.0.0.1:${server.address().port}`;
@@ -206,6 +209,19 @@ test('the header stays on one line at 1000 px, and the point cloud is shaded, no
   const share = await page.evaluate(() => window.kdmeshViewer.commonestColourShare());
   await page.screenshot({ path: join(screenshots, 'points.png') });
   assert.ok(share > 0 && share < 0.2, `share of the commonest colour: ${share}`);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('a model with vertex colours shows them, and the status names its attributes', async () => {
+  const { page, errors } = await openViewer('model=coloured');
+  await page.waitForFunction(() => window.kdmeshViewer.state === 'complete', null, { timeout: 60000 });
+  const state = await viewerState(page);
+  const vivid = await page.evaluate(() => window.kdmeshViewer.vividPixels());
+  await page.screenshot({ path: join(screenshots, 'coloured.png') });
+  assert.deepEqual(state.attributes, ['color', 'normal', 'uv', 'label']);
+  assert.match(await page.$eval('#status', (status) => status.textContent), /· color, normal, uv, label ·/);
+  assert.ok(vivid.red > 500 && vivid.blue > 500, `vivid pixels: ${JSON.stringify(vivid)}`);
   assert.deepEqual(errors, []);
   await page.close();
 });

@@ -20,15 +20,21 @@ function random(seed) {
   };
 }
 
-// An ascii PLY of any complex (vertex, edge, face and tetra elements).
-function writePly(path, { positions, edges = [], triangles = [], tetrahedra = [] }) {
+// An ascii PLY of any complex (vertex, edge, face and tetra elements), with
+// vertex attributes: each { name, type (a PLY type), properties (the PLY
+// names of its components), values (properties.length per vertex) }.
+export function writePly(path, { positions, edges = [], triangles = [], tetrahedra = [], attributes = [] }) {
   const n = positions.length / 3;
   const lines = ['ply', 'format ascii 1.0', `element vertex ${n}`, 'property float x', 'property float y', 'property float z'];
+  for (const { type, properties } of attributes) for (const name of properties) lines.push(`property ${type} ${name}`);
   if (edges.length) lines.push(`element edge ${edges.length / 2}`, 'property int vertex1', 'property int vertex2');
   if (triangles.length) lines.push(`element face ${triangles.length / 3}`, 'property list uchar int vertex_indices');
   if (tetrahedra.length) lines.push(`element tetra ${tetrahedra.length / 4}`, 'property list uchar int vertex_indices');
   lines.push('end_header');
-  for (let i = 0; i < n; ++i) lines.push(`${positions[3 * i]} ${positions[3 * i + 1]} ${positions[3 * i + 2]}`);
+  for (let i = 0; i < n; ++i) {
+    const values = attributes.flatMap(({ properties, values }) => values.slice(i * properties.length, (i + 1) * properties.length));
+    lines.push([positions[3 * i], positions[3 * i + 1], positions[3 * i + 2], ...values].join(' '));
+  }
   for (let i = 0; i < edges.length; i += 2) lines.push(`${edges[i]} ${edges[i + 1]}`);
   for (let i = 0; i < triangles.length; i += 3) lines.push(`3 ${triangles[i]} ${triangles[i + 1]} ${triangles[i + 2]}`);
   for (let i = 0; i < tetrahedra.length; i += 4) lines.push(`4 ${tetrahedra.slice(i, i + 4).join(' ')}`);
@@ -48,6 +54,52 @@ function torus(rows, columns) {
     for (let i = 0; i < columns; ++i)
       triangles.push(id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j), id(i + 1, j + 1), id(i, j + 1));
   return { positions, triangles };
+}
+
+// A torus with the attributes three.js draws: 'color' (uchar red green
+// blue: red on one side, blue on the other), 'normal' (float nx ny nz: the
+// torus's own normals, which differ from those of its triangles), 'uv'
+// (float u v) and 'label' (short, negative values too). Float values are
+// float32 numbers, so that the PLY's text holds them exactly.
+export function colouredTorus(rows = 24, columns = 40) {
+  const { positions, triangles } = torus(rows, columns);
+  const color = [], normal = [], uv = [], label = [];
+  for (let j = 0; j < rows; ++j)
+    for (let i = 0; i < columns; ++i) {
+      const a = (2 * Math.PI * i) / columns, b = (2 * Math.PI * j) / rows;
+      const red = Math.round(127.5 + 127.5 * Math.cos(a));
+      color.push(red, Math.round(60 + 40 * Math.sin(b)), 255 - red);
+      normal.push(...[Math.cos(b) * Math.cos(a), Math.cos(b) * Math.sin(a), Math.sin(b)].map(Math.fround));
+      uv.push(Math.fround(i / columns), Math.fround(j / rows));
+      label.push(((37 * j + 11 * i) % 700) - 350);
+    }
+  return {
+    positions, triangles, attributes: [
+      { name: 'color', type: 'uchar', properties: ['red', 'green', 'blue'], values: color },
+      { name: 'normal', type: 'float', properties: ['nx', 'ny', 'nz'], values: normal },
+      { name: 'uv', type: 'float', properties: ['u', 'v'], values: uv },
+      { name: 'label', type: 'short', properties: ['label'], values: label },
+    ],
+  };
+}
+
+// A point cloud with RGBA colours and a float 'intensity'; every tenth point
+// repeats the previous one's position with other values.
+export function colouredCloud(count = 2000, seed = 5) {
+  const rand = random(seed);
+  const positions = [], color = [], intensity = [];
+  for (let i = 0; i < count; ++i) {
+    if (i % 10 === 9) positions.push(...positions.slice(-3));
+    else positions.push(rand() * 10 - 5, rand() * 10 - 5, rand() * 10 - 5);
+    color.push(...[0, 1, 2, 3].map(() => Math.floor(256 * rand())));
+    intensity.push(Math.fround(rand() * 1000 - 500));
+  }
+  return {
+    positions, attributes: [
+      { name: 'color', type: 'uchar', properties: ['red', 'green', 'blue', 'alpha'], values: color },
+      { name: 'intensity', type: 'float', properties: ['intensity'], values: intensity },
+    ],
+  };
 }
 
 function tetrahedralBlock(n, seed) {
@@ -125,7 +177,16 @@ export function makeFixtures() {
   return fixtures;
 }
 
-// Reads the binary PLY that `kdmesh decode` writes.
+// PLY scalar types by name: the typed array that holds one.
+const plyTypes = {
+  char: Int8Array, int8: Int8Array, uchar: Uint8Array, uint8: Uint8Array, short: Int16Array, int16: Int16Array,
+  ushort: Uint16Array, uint16: Uint16Array, int: Int32Array, int32: Int32Array, uint: Uint32Array, uint32: Uint32Array,
+  float: Float32Array, float32: Float32Array, double: Float64Array, float64: Float64Array,
+};
+
+// Reads the binary PLY that `kdmesh decode` writes: positions, the lists of
+// simplices, and `properties`, the vertex properties besides x, y and z by
+// name, each a typed array of its own type.
 function parsePly(buffer) {
   const end = buffer.indexOf('end_header\n') + 'end_header\n'.length;
   const header = buffer.subarray(0, end).toString('latin1').split('\n');
@@ -135,21 +196,36 @@ function parsePly(buffer) {
     if (words[0] === 'element') elements.push({ name: words[1], count: Number(words[2]), properties: [] });
     else if (words[0] === 'property') elements.at(-1).properties.push(words);
   }
-  const model = { positions: null, points: [], edges: [], triangles: [], tetrahedra: [] };
+  const model = { positions: null, points: [], edges: [], triangles: [], tetrahedra: [], properties: {} };
+  const data = new DataView(buffer.buffer, buffer.byteOffset, buffer.byteLength);
   let at = end;
   for (const element of elements) {
     if (element.name === 'vertex') {
-      model.positions = new Float32Array(buffer.buffer.slice(buffer.byteOffset + at, buffer.byteOffset + at + 12 * element.count));
-      at += 12 * element.count;
+      const columns = element.properties.map(([, type, name]) => {
+        const Type = plyTypes[type];
+        const values = new Type(element.count);
+        if (!'xyz'.includes(name)) model.properties[name] = values;
+        return { values, bytes: Type.BYTES_PER_ELEMENT };
+      });
+      for (let i = 0; i < element.count; ++i) {
+        for (const { values, bytes } of columns) {
+          // Little-endian bytes into the value's own type, bit for bit.
+          new Uint8Array(values.buffer, i * bytes, bytes).set(buffer.subarray(at, at + bytes));
+          at += bytes;
+        }
+      }
+      const [x, y, z] = ['x', 'y', 'z'].map((name) => columns[element.properties.findIndex((p) => p[2] === name)].values);
+      model.positions = new Float32Array(3 * element.count);
+      for (let i = 0; i < element.count; ++i) model.positions.set([x[i], y[i], z[i]], 3 * i);
       continue;
     }
     const list = element.name === 'edge' ? model.edges : element.name === 'face' ? model.triangles : model.tetrahedra;
     for (let i = 0; i < element.count; ++i) {
       if (element.properties[0][1] === 'list') {
         const count = buffer[at++];
-        for (let k = 0; k < count; ++k, at += 4) list.push(buffer.readUInt32LE(at));
+        for (let k = 0; k < count; ++k, at += 4) list.push(data.getUint32(at, true));
       } else {
-        for (let k = 0; k < element.properties.length; ++k, at += 4) list.push(buffer.readUInt32LE(at));
+        for (let k = 0; k < element.properties.length; ++k, at += 4) list.push(data.getUint32(at, true));
       }
     }
   }

@@ -1,7 +1,9 @@
 // Uses every export of kdmesh and kdmesh/three as a TypeScript program
 // would; tests/types/types.test.mjs compiles it with tsc --strict.
-import { compileWasm, createDecoder, decode, Decoder, Header, KdmeshError, memoryInUse, Model, Progress, setWasmSource } from 'kdmesh';
-import { GpuFence, KDMeshLoader, LoadStats } from 'kdmesh/three';
+import {
+  compileWasm, createDecoder, decode, Decoder, Header, KdmeshError, memoryInUse, Model, Progress, setWasmSource, VertexAttribute,
+} from 'kdmesh';
+import { GpuFence, KDMeshLoader, LoadStats, StreamedModel } from 'kdmesh/three';
 import { BufferGeometry, Group, LoadingManager, Mesh, MeshNormalMaterial, PerspectiveCamera, Scene, WebGLRenderer } from 'three';
 
 export async function decoding(bytes: Uint8Array): Promise<number> {
@@ -14,6 +16,8 @@ export async function decoding(bytes: Uint8Array): Promise<number> {
   const header: Header | null = decoder.header;
   const coarse = decoder.snapshot({ copy: false });
   const parents: Uint32Array = decoder.parents();
+  const colour: VertexAttribute | undefined = coarse.attributes.color;
+  const attributeValues = (colour?.array.length ?? 0) + (colour?.itemSize ?? 0) + (header?.attributeCount ?? 0);
   decoder.finish();
   decoder.dispose();
   try {
@@ -22,7 +26,7 @@ export async function decoding(bytes: Uint8Array): Promise<number> {
     if (error instanceof KdmeshError) return error.code.length;
   }
   return model.positions.length + progress.errorBound + (header?.simplexCounts[2] ?? 0) + coarse.triangles.length +
-    parents.length + (await memoryInUse()) + (model.stats.bitsPerVertex > 0 ? 1 : 0);
+    parents.length + attributeValues + (await memoryInUse()) + (model.stats.bitsPerVertex > 0 ? 1 : 0);
 }
 
 export async function loading(renderer: WebGLRenderer): Promise<BufferGeometry> {
@@ -47,7 +51,10 @@ export async function loading(renderer: WebGLRenderer): Promise<BufferGeometry> 
     geomorph: true,
     tetrahedra: 'wireframe',
     limits: { maxSimplices: 1e7 },
-    onRefine: (object: Group, stats: LoadStats) => object.visible === stats.complete,
+    onRefine: (object: Group, stats: LoadStats) => {
+      const level: StreamedModel | null = stats.model;
+      return object.visible === stats.complete && (level?.normals.length ?? 0) >= (level?.attributes.normal?.array.length ?? 0);
+    },
     onHeader: (header: Header) => header.totalBytes,
     onProgress: (stats: LoadStats, event: ProgressEvent) => stats.bytesReceived + event.loaded,
   });
