@@ -42,7 +42,8 @@ export interface Header {
   step: number;
   totalBytes: number;
   chunkCount: number;
-  /** Levels of the kd-tree: `progress.level` reaches it when the stream is complete. */
+  /** Levels of the kd-tree: `progress.level` reaches it when the stream is complete (and goes past it
+   * while coincident vertices of meshes and of attribute streams split apart). */
   depth: number;
   /** Vertex attributes the stream carries (their names arrive with the first snapshot). */
   attributeCount: number;

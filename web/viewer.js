@@ -223,7 +223,10 @@ function describe(stats) {
   const kb = (viewer.bytesReceived / 1024).toFixed(0);
   const total = viewer.bytesExpected ? ` of ${(viewer.bytesExpected / 1024).toFixed(0)}` : '';
   const bpv = m && m.vertexCount ? ((8 * m.progress.bytesConsumed) / m.vertexCount).toFixed(1) : '–';
-  return `${kb}${total} KiB · level ${viewer.level}${of(viewer.levelCount)} · ${count(viewer.vertexCount)}${of(viewer.vertexTotal)} vertices` +
+  // Levels past the kd-tree's depth only tell coincident vertices apart:
+  // the status counts them as the last.
+  const level = viewer.levelCount ? Math.min(viewer.level, viewer.levelCount) : viewer.level;
+  return `${kb}${total} KiB · level ${level}${of(viewer.levelCount)} · ${count(viewer.vertexCount)}${of(viewer.vertexTotal)} vertices` +
     (viewer.triangleCount ? ` · ${count(viewer.triangleCount)} triangles` : '') +
     (viewer.tetrahedronCount ? ` · ${count(viewer.tetrahedronCount)} tetrahedra` : '') +
     (viewer.edgeCount ? ` · ${count(viewer.edgeCount)} edges` : '') +
