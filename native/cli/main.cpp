@@ -35,6 +35,11 @@ void clearProgress() {
   gProgressShown = false;
 }
 
+// "1 vertex", "2 vertices".
+std::string counted(size_t count, const char* one, const char* many) {
+  return std::to_string(count) + " " + (count == 1 ? one : many);
+}
+
 // Error messages are one line, whatever the text they quote, and reach the
 // terminal without control characters: line breaks become spaces, the rest
 // (escape sequences, say) \xHH.
@@ -180,10 +185,12 @@ int runEncode(const EncodeArgs& args) {
   if (!gQuiet) {
     const double n = double(complex.vertexCount());
     std::fprintf(stderr,
-                 "%s: %zu vertices, %zu simplices -> %zu bytes, %.3f bits/vertex (connectivity %.3f, "
+                 "%s: %s, %s -> %zu bytes, %.3f bits/vertex (connectivity %.3f, "
                  "geometry %.3f) [read %.3fs, encode %.3fs]\n",
-                 args.output.c_str(), complex.vertexCount(),
-                 complex.simplexCount(1) + complex.simplexCount(2) + complex.simplexCount(3),
+                 args.output.c_str(), counted(complex.vertexCount(), "vertex", "vertices").c_str(),
+                 counted(complex.simplexCount(1) + complex.simplexCount(2) + complex.simplexCount(3), "simplex",
+                         "simplices")
+                     .c_str(),
                  result.bytes.size(), 8.0 * double(result.bytes.size()) / n,
                  result.cost.connectivityBits / n, result.cost.geometryBits / n, readSeconds,
                  encodeSeconds);

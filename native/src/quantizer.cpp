@@ -35,8 +35,8 @@ Status checkFinite(const std::vector<float>& positions) {
     if (!std::isfinite(positions[i])) {
       static const char* kAxis = "xyz";
       return Status::error(ErrorCode::InvalidInput,
-                           "vertex " + std::to_string(i / 3) + " has a " +
-                               (std::isnan(positions[i]) ? "NaN" : "infinite") + " " +
+                           "vertex " + std::to_string(i / 3) + " has " +
+                               (std::isnan(positions[i]) ? "a NaN" : "an infinite") + " " +
                                kAxis[i % 3] + " coordinate");
     }
   }

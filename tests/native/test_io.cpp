@@ -343,7 +343,7 @@ TEST(IoPly, ReadsAsciiWithDoublesExtraPropertiesAndCrlf) {
   EXPECT_FALSE(r.hasNote("vertex properties")) << joined(r.notes);
   EXPECT_TRUE(r.hasNote("flags")) << joined(r.notes);
   EXPECT_TRUE(r.hasNote("double")) << joined(r.notes);
-  EXPECT_TRUE(r.hasNote("split 1 polygons")) << joined(r.notes);
+  EXPECT_TRUE(r.hasNote("split 1 polygon with")) << joined(r.notes);
   EXPECT_EQ(r.notes.size(), 3u) << joined(r.notes);
 
   // Values after the declared elements are noted, not dropped silently.
@@ -423,7 +423,7 @@ TEST(IoPly, ReadsBinaryInBothByteOrdersWithFloatOrDoubleCoordinates) {
         EXPECT_EQ(r.complex.attributes[0].name, "red");
         EXPECT_EQ(r.complex.attributes[0].values, std::vector<uint8_t>(4, 200));
         EXPECT_TRUE(r.hasNote("material")) << joined(r.notes);
-        EXPECT_TRUE(r.hasNote("split 1 polygons")) << joined(r.notes);
+        EXPECT_TRUE(r.hasNote("split 1 polygon with")) << joined(r.notes);
         EXPECT_EQ(r.hasNote("double"), doubles) << joined(r.notes);
       }
     }
@@ -646,10 +646,13 @@ TEST(IoObj, ReadsVerticesPointsLinesFacesAndCorners) {
                                                           3, 2, 1, 4, 0, 1}));
   EXPECT_EQ(r.complex.edges, (std::vector<uint32_t>{0, 1, 1, 2, 3, 0}));
   EXPECT_EQ(r.complex.points, (std::vector<uint32_t>{1, 0, 2}));
-  EXPECT_TRUE(r.hasNote("split 1 polygons")) << joined(r.notes);
+  EXPECT_TRUE(r.hasNote("split 1 polygon with")) << joined(r.notes);
   EXPECT_TRUE(r.hasNote("extra columns")) << joined(r.notes);
   EXPECT_TRUE(r.hasNote("'curv' on line 23")) << joined(r.notes);
-  EXPECT_EQ(r.notes.size(), 3u) << joined(r.notes);
+  // What the OBJ held that the complex does not, counted by keyword.
+  EXPECT_TRUE(r.hasNote("1 texture coordinates (vt), 1 normals (vn), 1 group names (g)")) << joined(r.notes);
+  EXPECT_TRUE(r.hasNote("1 material uses (usemtl), 1 material libraries (mtllib)")) << joined(r.notes);
+  EXPECT_EQ(r.notes.size(), 4u) << joined(r.notes);
 }
 
 TEST(IoObj, BadIndicesAndTokensNameTheLine) {
@@ -696,7 +699,7 @@ TEST(IoOff, ReadsCommentsColoursPolygonsAndCountsOnTheKeywordLine) {
   EXPECT_EQ(bitsOf(r.complex.positions[11]), 0x80000001u);
   EXPECT_EQ(r.complex.triangles,
             (std::vector<uint32_t>{0, 1, 2, 0, 1, 2, 0, 2, 3, 3, 2, 1}));
-  EXPECT_TRUE(r.hasNote("split 1 polygons")) << joined(r.notes);
+  EXPECT_TRUE(r.hasNote("split 1 polygon with")) << joined(r.notes);
   EXPECT_TRUE(r.hasNote("colour values on 1 faces")) << joined(r.notes);
   EXPECT_TRUE(r.hasNote("on 1 vertices")) << joined(r.notes);
 

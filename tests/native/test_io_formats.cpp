@@ -162,7 +162,8 @@ TEST(IoStl, BinarySoupKeepsBitsEvenWhenTheHeaderStartsWithSolid) {
     }
     EXPECT_EQ(bitsOf(r.complex.positions), bitsOf(expected));
     EXPECT_TRUE(r.hasNote("attribute values (often a colour) of 1 triangles")) << joined(r.notes);
-    EXPECT_EQ(r.notes.size(), 1u) << joined(r.notes);
+    EXPECT_TRUE(r.hasNote("facet normals of")) << joined(r.notes);
+    EXPECT_EQ(r.notes.size(), 2u) << joined(r.notes);
   }
   // An empty binary STL and bytes after the triangles.
   const ReadResult empty = readBytes(Format::Stl, binaryStl("solid", {}));
@@ -207,8 +208,9 @@ TEST(IoStl, AsciiSoupWithCrlfUppercaseSeveralSolidsAndAPolygon) {
               (std::vector<uint32_t>{0, 1, 2, 3, 4, 5, 6, 7, 8, 6, 8, 9}));
     EXPECT_EQ(bitsOf(r.complex.positions[2 * 3 + 2]), bitsOf(0.1f));
     EXPECT_EQ(bitsOf(r.complex.positions[4 * 3 + 2]), bitsOf(-0.0f));
-    EXPECT_TRUE(r.hasNote("split 1 polygons")) << joined(r.notes);
-    EXPECT_EQ(r.notes.size(), 1u) << joined(r.notes);
+    EXPECT_TRUE(r.hasNote("split 1 polygon with")) << joined(r.notes);
+    EXPECT_TRUE(r.hasNote("facet normals of 3 triangles")) << joined(r.notes);
+    EXPECT_EQ(r.notes.size(), 2u) << joined(r.notes);
   }
   // No endsolid: read, with a note.
   const ReadResult open = readText(Format::Stl, text.substr(0, text.find("endsolid part one")));
@@ -398,7 +400,7 @@ TEST(IoMedit, ReadsCommentsCrlfWrappedValuesQuadsAndSkippedSections) {
     EXPECT_EQ(r.complex.triangles, (std::vector<uint32_t>{0, 1, 2, 0, 2, 3, 3, 4, 0}));
     EXPECT_EQ(r.complex.tetrahedra, (std::vector<uint32_t>{0, 1, 3, 4}));
     EXPECT_TRUE(r.complex.points.empty());
-    EXPECT_TRUE(r.hasNote("split 1 polygons")) << joined(r.notes);
+    EXPECT_TRUE(r.hasNote("split 1 polygon with")) << joined(r.notes);
     EXPECT_TRUE(r.hasNote("skipped 2 Corners")) << joined(r.notes);
     EXPECT_TRUE(r.hasNote("skipped 1 Hexahedra")) << joined(r.notes);
     EXPECT_TRUE(r.hasNote("nonzero references of 4")) << joined(r.notes);
@@ -764,7 +766,7 @@ TEST(IoVtk, ReadsVersion5OffsetsAndPolyData) {
   EXPECT_EQ(p.complex.edges, (std::vector<uint32_t>{0, 1, 1, 2}));
   EXPECT_EQ(p.complex.triangles,
             (std::vector<uint32_t>{0, 1, 2, 0, 2, 3, 3, 2, 1, 0, 1, 3, 3, 1, 2}));
-  EXPECT_TRUE(p.hasNote("split 1 polygons")) << joined(p.notes);
+  EXPECT_TRUE(p.hasNote("split 1 polygon with")) << joined(p.notes);
 }
 
 TEST(IoVtk, BadInputIsRejectedWithTheLine) {

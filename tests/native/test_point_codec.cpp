@@ -142,7 +142,7 @@ TEST(PointCodec, RejectsNonFiniteCoordinatesNamingTheVertex) {
   p[3 * 6 + 1] = 0;
   p[3 * 2 + 2] = -std::numeric_limits<float>::infinity();
   r = encode(pointCloud(p), EncodeOptions{});
-  EXPECT_NE(r.status.message.find("vertex 2 has a infinite z"), std::string::npos) << r.status.message;
+  EXPECT_NE(r.status.message.find("vertex 2 has an infinite z"), std::string::npos) << r.status.message;
 }
 
 TEST(PointCodec, RejectsBadOptionsAndEmptyInput) {

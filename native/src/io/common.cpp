@@ -30,6 +30,15 @@ bool TextScanner::nextLine() {
   const void* newline = std::memchr(cursor_, '\n', end_ - cursor_);
   lineEnd_ = newline ? static_cast<const char*>(newline) : end_;
   next_ = newline ? lineEnd_ + 1 : end_;
+  // A carriage return not followed by the newline ends the line by itself
+  // (files written with CR line endings alone).
+  if (const void* cr = std::memchr(cursor_, '\r', lineEnd_ - cursor_)) {
+    const char* at = static_cast<const char*>(cr);
+    if (at + 1 != lineEnd_) {
+      lineEnd_ = at;
+      next_ = at + 1;
+    }
+  }
   ++line_;
   return true;
 }
@@ -231,7 +240,8 @@ void PolygonSplit::append(const uint32_t* polygon, size_t size,
 void PolygonSplit::addNote(Notes& notes) const {
   if (polygons == 0) return;
   notes.push_back("split " + std::to_string(polygons) +
-                  " polygons with more than 3 vertices into " +
+                  (polygons == 1 ? " polygon" : " polygons") +
+                  " with more than 3 vertices into " +
                   std::to_string(triangles) + " triangles");
 }
 

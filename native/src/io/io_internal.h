@@ -125,7 +125,7 @@ struct TextSyntax {
 };
 
 // Splits text into lines and whitespace-separated tokens without copying.
-// '\r' counts as whitespace, so CRLF files need no special case.
+// Lines end in LF, CRLF or CR alone; '\r' also counts as whitespace.
 class TextScanner {
  public:
   TextScanner(const uint8_t* data, size_t size, TextSyntax syntax = {});
@@ -157,7 +157,7 @@ class TextScanner {
   const char* begin_;
   const char* end_;
   const char* cursor_;   // inside the current line
-  const char* lineEnd_;  // the '\n' ending the current line, or end_
+  const char* lineEnd_;  // the line ending of the current line, or end_
   const char* next_;     // start of the next line
   size_t line_ = 0;
   TextSyntax syntax_;

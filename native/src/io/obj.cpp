@@ -5,13 +5,22 @@
 namespace kdmesh::io::detail {
 namespace {
 
-// Keywords that carry nothing a simplicial complex holds; skipped silently.
-bool isIgnoredKeyword(std::string_view keyword) {
-  for (std::string_view ignored :
-       {"vt", "vn", "vp", "g", "o", "s", "usemtl", "mtllib"}) {
-    if (keyword == ignored) return true;
-  }
-  return false;
+// Keywords whose data kdmesh does not keep (yet), and what they hold: each
+// skipped line is counted, and the counts noted.
+constexpr struct {
+  std::string_view keyword, what;
+} kSkippedKeywords[] = {
+    {"vt", "texture coordinates (vt)"}, {"vn", "normals (vn)"},       {"vp", "parameter-space vertices (vp)"},
+    {"g", "group names (g)"},           {"o", "object names (o)"},    {"s", "smoothing groups (s)"},
+    {"usemtl", "material uses (usemtl)"}, {"mtllib", "material libraries (mtllib)"},
+};
+constexpr size_t kSkippedKinds = sizeof kSkippedKeywords / sizeof kSkippedKeywords[0];
+
+// The index of a skipped keyword, or kSkippedKinds.
+size_t skippedKind(std::string_view keyword) {
+  for (size_t i = 0; i < kSkippedKinds; ++i)
+    if (keyword == kSkippedKeywords[i].keyword) return i;
+  return kSkippedKinds;
 }
 
 const char* simplexName(char keyword) {
@@ -59,9 +68,11 @@ Status readIndexLine(TextScanner& scanner, char keyword, size_t verticesSoFar,
     if (!resolveIndex(value, verticesSoFar, index)) {
       return lineError(scanner.lineNumber(),
                        std::string(simplexName(keyword)) + " vertex index " +
-                           std::to_string(value) + " is out of range (" +
+                           std::to_string(value) +
+                           " is out of range: OBJ numbers vertices from 1 (and "
+                           "from -1 back from the last), " +
                            std::to_string(verticesSoFar) +
-                           " vertices defined so far)");
+                           " defined so far");
     }
     indices.push_back(index);
   }
@@ -101,6 +112,7 @@ Status readObj(const uint8_t* data, size_t size, Complex& out, Notes& notes) {
   PolygonSplit split;
   size_t extraColumnLines = 0;
   size_t unknownLines = 0;
+  size_t skipped[kSkippedKinds] = {};
   std::string firstUnknown;
   std::string_view keyword;
   while (scanner.nextLine()) {
@@ -115,7 +127,9 @@ Status readObj(const uint8_t* data, size_t size, Complex& out, Notes& notes) {
           readIndexLine(scanner, keyword[0], out.vertexCount(), indices);
       if (!status.ok()) return status;
       addSimplices(keyword[0], indices, out, split);
-    } else if (!isIgnoredKeyword(keyword)) {
+    } else if (const size_t kind = skippedKind(keyword); kind < kSkippedKinds) {
+      ++skipped[kind];
+    } else {
       if (unknownLines++ == 0) {
         firstUnknown = quoted(keyword) + " on line " +
                        std::to_string(scanner.lineNumber());
@@ -125,6 +139,14 @@ Status readObj(const uint8_t* data, size_t size, Complex& out, Notes& notes) {
   addCountNote(notes, "ignored extra columns (w or colour) on ",
                extraColumnLines, " vertex lines");
   split.addNote(notes);
+  std::string lost;
+  for (size_t i = 0; i < kSkippedKinds; ++i)
+    if (skipped[i] > 0)
+      lost += (lost.empty() ? "" : ", ") + std::to_string(skipped[i]) + " " + std::string(kSkippedKeywords[i].what);
+  if (!lost.empty()) {
+    notes.push_back("ignored " + lost +
+                    ": kdmesh keeps an OBJ's vertex positions, faces, lines and points only");
+  }
   if (unknownLines > 0) {
     notes.push_back("ignored " + std::to_string(unknownLines) +
                     " lines with unknown keywords (the first: " +

@@ -129,6 +129,13 @@ Status readBinaryCount(Bytes head, uint64_t size, uint64_t& count) {
   return Status::success();
 }
 
+// The facet normals are not kept (every viewer recomputes them from the
+// corners): a note counts the facets that gave one.
+void addFacetNormalNote(Notes& notes, size_t withNormal) {
+  addCountNote(notes, "ignored the facet normals of ", withNormal,
+               " triangles (kdmesh keeps the corners; normals follow from them)");
+}
+
 Status readBinary(Input& input, uint64_t size, Complex& out, Notes& notes,
                   bool weld) {
   uint64_t count = 0;
@@ -139,7 +146,7 @@ Status readBinary(Input& input, uint64_t size, Complex& out, Notes& notes,
   Soup soup(out, weld);
   soup.reserve(count);
   ByteStream bytes = input.stream(kStlPrefixBytes);
-  size_t withAttribute = 0;
+  size_t withAttribute = 0, withNormal = 0;
   for (uint64_t t = 0; t < count; ++t) {
     const uint8_t* triangle = bytes.take(kStlTriangleBytes);
     if (triangle == nullptr) {
@@ -156,7 +163,11 @@ Status readBinary(Input& input, uint64_t size, Complex& out, Notes& notes,
     }
     soup.facet(corners, 3);
     withAttribute += (triangle[48] | triangle[49]) != 0;
+    bool normal = false;
+    for (size_t i = 0; i < 12; ++i) normal |= triangle[i] != 0;
+    withNormal += normal;
   }
+  addFacetNormalNote(notes, withNormal);
   addCountNote(notes, "ignored the attribute values (often a colour) of ",
                withAttribute, " triangles");
   addCountNote(notes, "ignored ", bytes.remaining(),
@@ -195,6 +206,7 @@ class AsciiStl {
       notes.push_back("the ascii STL ends without 'endsolid' (truncated "
                       "file?)");
     }
+    addFacetNormalNote(notes, withNormal_);
     soup_.addNotes(notes);
     return Status::success();
   }
@@ -245,13 +257,16 @@ class AsciiStl {
 
   // After "facet": the normal, the loop of vertices and "endfacet".
   Status readFacet() {
-    float ignored;
+    float normal;
+    bool given = false;
     if (Status status = expect("normal"); !status.ok()) return status;
     for (int axis = 0; axis < 3; ++axis) {
-      if (Status status = number(ignored, "normal"); !status.ok()) {
+      if (Status status = number(normal, "normal"); !status.ok()) {
         return status;
       }
+      given |= normal != 0;
     }
+    withNormal_ += given;
     for (const char* keyword : {"outer", "loop"}) {
       if (Status status = expect(keyword); !status.ok()) return status;
     }
@@ -287,6 +302,7 @@ class AsciiStl {
   TextScanner scanner_;
   Complex& out_;
   size_t facets_ = 0;
+  size_t withNormal_ = 0;  // facets with a nonzero normal
   std::vector<uint32_t> polygon_;  // vertices of one facet, reused
   Soup soup_;
 };
