@@ -121,6 +121,18 @@ export function paceKbps(value) {
   return Math.min(maxKbps, Math.max(minKbps, kbps));
 }
 
+// Resolves once `response` drains or the client is gone; either way its
+// listeners go, so that a long paced download does not pile them up.
+const whenDrainedOrGone = (response, signal) => new Promise((resolveWait) => {
+  function done() {
+    response.off('drain', done);
+    signal.removeEventListener('abort', done);
+    resolveWait();
+  }
+  response.once('drain', done);
+  signal.addEventListener('abort', done, { once: true });
+});
+
 const sleep = (ms, signal) => new Promise((resolveSleep) => {
   const timer = setTimeout(done, ms);
   function done() { clearTimeout(timer); signal.removeEventListener('abort', done); resolveSleep(); }
@@ -164,7 +176,7 @@ async function sendPaced(response, file, kbps) {
       if (sent > file.size) break;
       await sleep(Math.max(0, start + sent / bytesPerMs - Date.now()), gone.signal);
       if (gone.signal.aborted) return;
-      if (!response.write(chunk)) await new Promise((r) => { response.once('drain', r); gone.signal.addEventListener('abort', r, { once: true }); });
+      if (!response.write(chunk)) await whenDrainedOrGone(response, gone.signal);
       if (gone.signal.aborted) return;
     }
     if (sent !== file.size) throw new Error(`file changed while served (${sent} bytes read of ${file.size})`);
