@@ -107,7 +107,9 @@ void expectRoundTrip(const Complex& input, const EncodeOptions& options) {
     return out;
   };
   EXPECT_TRUE(keys(decoded) == keys(input)) << "vertices and their values differ";
-  if (input.hasSimplices() && options.exact) EXPECT_EQ(canonicalForm(decoded), canonicalForm(input));
+  if (input.hasSimplices() && options.exact) {
+    EXPECT_EQ(canonicalForm(decoded), canonicalForm(input));
+  }
 
   // Values of the input, whatever the position (a prefix's vertices stand
   // at their cells).
@@ -256,8 +258,9 @@ TEST(Attributes, PlyKeepsThemAndOtherFormatsRefuseThem) {
       EXPECT_EQ(back.attributes[a].type, mesh.attributes[a].type);
       EXPECT_EQ(back.attributes[a].components, mesh.attributes[a].components);
       // Ascii float text cannot carry NaN payloads: compare the bits elsewhere.
-      if (!ascii || mesh.attributes[a].type != AttributeType::Float32)
+      if (!ascii || mesh.attributes[a].type != AttributeType::Float32) {
         EXPECT_EQ(back.attributes[a].values, mesh.attributes[a].values) << mesh.attributes[a].name;
+      }
     }
   }
   // Properties named name_0, name_1, ... are one attribute of several components.
