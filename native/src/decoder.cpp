@@ -218,7 +218,7 @@ struct Decoder::State {
         return false;
       cost.connectivityBits += coder.cost() - before;
     }
-    if (named && !oneSided) decodeAttributes(cell.vertex, added);
+    if (!attributes.empty() && !oneSided) decodeAttributes(cell.vertex, added);
     for (const uint32_t half : {firstHalf, population - firstHalf}) {
       if (half == 1) {
         child.population = 1;
