@@ -6,10 +6,12 @@
 // surface plus its vertices (so it over-estimates by up to the sample
 // spacing); all relative to the bounding-box diagonal.
 //
-//   kdmesh_bench_rd [--bits B] [--points N] [--placement predicted|centre] MODEL
+//   kdmesh_bench_rd [--bits B] [--points N] [--placement predicted|centre] [--chunk-bytes N] MODEL
 //
 // --placement: where prefixes put vertices whose cells are not yet single
 // grid points (kdmesh::CoarsePlacement; predicted, the default, or centre).
+// --chunk-bytes: the encoder's largest chunk payload (EncodeOptions::chunkBytes):
+// prefixes decode whole chunks, so smaller chunks give a finer curve.
 //
 // Prints CSV: bytes,vertices,mean_error,max_error,hausdorff (hausdorff is
 // empty for models without triangles).
@@ -121,12 +123,14 @@ double directedHausdorff(const std::vector<Point>& from, const NearestPoint& to)
 
 int main(int argc, char** argv) {
   int bits = 12, samples = 40;
+  size_t chunkBytes = kdmesh::EncodeOptions{}.chunkBytes;
   kdmesh::DecoderOptions decoding;
   std::string path;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--bits" && i + 1 < argc) bits = std::atoi(argv[++i]);
     else if (arg == "--points" && i + 1 < argc) samples = std::max(2, std::atoi(argv[++i]));
+    else if (arg == "--chunk-bytes" && i + 1 < argc) chunkBytes = size_t(std::max(64, std::atoi(argv[++i])));
     else if (arg == "--placement" && i + 1 < argc) {
       const std::string placement = argv[++i];
       if (placement != "predicted" && placement != "centre") bench::fail("--placement takes predicted or centre");
@@ -134,7 +138,7 @@ int main(int argc, char** argv) {
           placement == "centre" ? kdmesh::CoarsePlacement::CellCentre : kdmesh::CoarsePlacement::Predicted;
     }
     else if (arg == "--help" || arg == "-h") {
-      std::printf("usage: kdmesh_bench_rd [--bits B] [--points N] [--placement predicted|centre] MODEL\n");
+      std::printf("usage: kdmesh_bench_rd [--bits B] [--points N] [--placement predicted|centre] [--chunk-bytes N] MODEL\n");
       return 0;
     } else path = arg;
   }
@@ -142,6 +146,7 @@ int main(int argc, char** argv) {
   const kdmesh::Complex model = bench::readModel(path);
   kdmesh::EncodeOptions options;
   options.bits = bits;
+  options.chunkBytes = chunkBytes;
   const kdmesh::EncodeResult encoded = kdmesh::encode(model, options);
   if (!encoded.status.ok()) bench::fail(encoded.status.message);
   const std::vector<uint8_t>& bytes = encoded.bytes;

@@ -93,8 +93,10 @@ struct Decoder::State {
   // Working memory of snapshots, kept from one to the next: a large
   // complex's arrays, allocated anew each time, cost a page fault per 4 KiB.
   struct SnapshotScratch {
-    std::vector<uint32_t> sideStart, sides;  // edgesInTriangles()
-    std::vector<uint8_t> edgeInTriangle;
+    // facesOfHigher(): lists of facets by lowest vertex, per dimension.
+    std::vector<uint32_t> facetStart, edgeFacets;
+    std::vector<uint64_t> triangleFacets;
+    std::vector<uint8_t> isFace;
     std::vector<float> centre, low, high, sum, normal;  // placeOnNeighbourPlanes()
     std::vector<uint32_t> degree;
   } scratch;
@@ -294,44 +296,71 @@ struct Decoder::State {
     singleLevelEnd = singles.size();
   }
 
-  // Which edges are sides of a triangle, indexed by edge (in
-  // scratch.edgeInTriangle). Each triangle's three sides are listed under
-  // their lower vertex by a counting sort in flat arrays; an edge is a side
-  // if its upper vertex is in its lower vertex's list. Flat passes, since
+  // Which simplices of dimension d (1 or 2) are faces of one of dimension
+  // d + 1, indexed by simplex (in scratch.isFace). The facets of every
+  // simplex one dimension up are listed under their lowest vertex by a
+  // counting sort in flat arrays, each as its other vertices (one id for an
+  // edge, two packed in a word for a triangle); a simplex is a face if its
+  // other vertices are in its lowest vertex's list. Flat passes, since
   // walking the vertices' linked incidence lists instead is a chain of
-  // dependent cache misses per vertex on a large complex.
-  const std::vector<uint8_t>& edgesInTriangles() {
-    std::vector<uint32_t>& start = scratch.sideStart;
-    std::vector<uint32_t>& sides = scratch.sides;
+  // dependent cache misses per vertex on a large complex. Long lists (a
+  // vertex in very many simplices) are sorted and searched by bisection,
+  // so the test stays O(n log n) however the simplices gather.
+  template <int d, class Rest>
+  const std::vector<uint8_t>& facesOfHigher(std::vector<Rest>& rests) {
+    static_assert(d == 1 || d == 2);
+    std::vector<uint32_t>& start = scratch.facetStart;
     start.assign(size_t(nextVertex) + 1, 0);
-    auto forEachSide = [this](auto&& visit) {
-      for (uint32_t triangle = 0; triangle < store.size(2); ++triangle) {
-        if (!(store.flags(2, triangle) & SimplexStore::kAlive)) continue;
-        const uint32_t* v = store.vertices(2, triangle);
-        for (int k = 0; k < 3; ++k) {
-          const uint32_t a = v[k], b = v[k == 2 ? 0 : k + 1];
-          visit(std::min(a, b), std::max(a, b));
+    // The vertices of a simplex of dimension d, ascending, split into the
+    // lowest and the rest.
+    auto split = [](const uint32_t* v, uint32_t& low, Rest& rest) {
+      uint32_t sorted[3] = {v[0], v[1], d == 2 ? v[2] : 0};
+      std::sort(sorted, sorted + d + 1);
+      low = sorted[0];
+      rest = d == 1 ? Rest(sorted[1]) : Rest(uint64_t(sorted[1]) << 32 | sorted[2]);
+    };
+    auto forEachFacet = [this, &split](auto&& visit) {
+      for (uint32_t higher = 0; higher < store.size(d + 1); ++higher) {
+        if (!(store.flags(d + 1, higher) & SimplexStore::kAlive)) continue;
+        const uint32_t* v = store.vertices(d + 1, higher);
+        for (int skip = 0; skip <= d + 1; ++skip) {
+          uint32_t facet[3] = {0, 0, 0};
+          for (int k = 0, n = 0; k <= d + 1; ++k)
+            if (k != skip) facet[n++] = v[k];
+          uint32_t low;
+          Rest rest;
+          split(facet, low, rest);
+          visit(low, rest);
         }
       }
     };
-    forEachSide([&](uint32_t low, uint32_t) { ++start[size_t(low) + 1]; });
+    forEachFacet([&](uint32_t low, Rest) { ++start[size_t(low) + 1]; });
     for (size_t v = 1; v < start.size(); ++v) start[v] += start[v - 1];
-    sides.resize(start.back());
+    rests.resize(start.back());
     // Filling moves each list's start to its end: list v is then
     // [start[v - 1], start[v]).
-    forEachSide([&](uint32_t low, uint32_t high) { sides[start[low]++] = high; });
-    std::vector<uint8_t>& inTriangle = scratch.edgeInTriangle;
-    inTriangle.assign(store.size(1), 0);
-    for (uint32_t edge = 0; edge < store.size(1); ++edge) {
-      if (!(store.flags(1, edge) & SimplexStore::kAlive)) continue;
-      const uint32_t* v = store.vertices(1, edge);
-      const uint32_t low = std::min(v[0], v[1]), high = std::max(v[0], v[1]);
-      const uint32_t* first = sides.data() + (low == 0 ? 0 : start[low - 1]);
-      const uint32_t* last = sides.data() + start[low];
-      inTriangle[edge] = std::find(first, last, high) != last;
+    forEachFacet([&](uint32_t low, Rest rest) { rests[start[low]++] = rest; });
+    auto list = [&](uint32_t low) {
+      return std::make_pair(rests.data() + (low == 0 ? 0 : start[low - 1]), rests.data() + start[low]);
+    };
+    for (uint32_t v = 0; v < nextVertex; ++v) {
+      const auto [first, last] = list(v);
+      if (last - first > kLongFacetList) std::sort(first, last);
     }
-    return inTriangle;
+    std::vector<uint8_t>& isFace = scratch.isFace;
+    isFace.assign(store.size(d), 0);
+    for (uint32_t simplex = 0; simplex < store.size(d); ++simplex) {
+      if (!(store.flags(d, simplex) & SimplexStore::kAlive)) continue;
+      uint32_t low;
+      Rest rest;
+      split(store.vertices(d, simplex), low, rest);
+      const auto [first, last] = list(low);
+      isFace[simplex] = last - first > kLongFacetList ? std::binary_search(first, last, rest)
+                                                       : std::find(first, last, rest) != last;
+    }
+    return isFace;
   }
+  static constexpr ptrdiff_t kLongFacetList = 32;
 
   // Appends the maximal simplices of the current complex, oriented, and its
   // isolated vertices.
@@ -348,10 +377,12 @@ struct Decoder::State {
       // A simplex can be a face only while simplices one dimension up exist.
       const bool testFaces = d < 3 && store.liveCount(d + 1) > 0 && (!finished || maximal != store.liveCount(d));
       list.reserve(size_t(finished ? maximal : store.liveCount(d)) * size_t(d + 1));
-      const std::vector<uint8_t>& edgeIsFace = d == 1 && testFaces ? edgesInTriangles() : scratch.edgeInTriangle;
+      const std::vector<uint8_t>& isFace = !testFaces ? scratch.isFace
+                                           : d == 1      ? facesOfHigher<1>(scratch.edgeFacets)
+                                                         : facesOfHigher<2>(scratch.triangleFacets);
       for (uint32_t simplex = 0; simplex < store.size(d); ++simplex) {
         if (!(store.flags(d, simplex) & SimplexStore::kAlive)) continue;
-        if (testFaces && (d == 1 ? bool(edgeIsFace[simplex]) : store.isFace(d, simplex))) continue;
+        if (testFaces && isFace[simplex]) continue;
         const uint32_t* v = store.vertices(d, simplex);
         const size_t at = list.size();
         list.insert(list.end(), v, v + d + 1);

@@ -119,18 +119,6 @@ bool SimplexStore::hasIncident(int dimension, uint32_t vertex) const {
   return forEachIncident(dimension, vertex, [](uint32_t, uint32_t) { return true; });
 }
 
-bool SimplexStore::isFace(int dimension, uint32_t simplex) const {
-  if (dimension >= kMaxDimension) return false;
-  const uint32_t* mine = vertices(dimension, simplex);
-  const int arity = dimension + 2;
-  return forEachIncident(dimension + 1, mine[0], [&](uint32_t candidate, uint32_t) {
-    const uint32_t* theirs = vertices(dimension + 1, candidate);
-    bool all = true;
-    for (int i = 1; i <= dimension && all; ++i) all = std::find(theirs, theirs + arity, mine[i]) != theirs + arity;
-    return all;
-  });
-}
-
 void SimplexStore::link(int dimension, uint32_t simplex, uint32_t position) {
   Pool& pool = pool_[dimension];
   const uint32_t slot = simplex * uint32_t(dimension + 1) + position;

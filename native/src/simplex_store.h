@@ -122,8 +122,6 @@ class SimplexStore {
     return false;
   }
   bool hasIncident(int dimension, uint32_t vertex) const;
-  // Whether a live simplex of dimension + 1 has this simplex as a face.
-  bool isFace(int dimension, uint32_t simplex) const;
 
   // Empties `vertex`'s list of `dimension` without touching the simplices;
   // the caller relinks every slot it keeps with link().

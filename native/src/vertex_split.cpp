@@ -1,6 +1,7 @@
 #include "vertex_split.h"
 
 #include <cmath>
+#include <utility>
 
 namespace kdmesh {
 namespace {
@@ -501,19 +502,92 @@ const std::vector<uint32_t>& VertexSplitter::around(int dimension) {
       list.push_back(entry.added);
     }
   }
+  // Large stars get an index of their simplices' facets with, per facet,
+  // how many decided simplices induce each orientation on it: a vote then
+  // reads the counts of its simplex's facets instead of polling the star.
+  std::vector<FacetEntry>& facets = facets_[size_t(dimension)];
+  facets.clear();
+  if (list.size() > kIndexedStar) {
+    for (const uint32_t simplex : list)
+      for (int skip = 0; skip <= dimension; ++skip)
+        facets.push_back({facetKey(dimension, simplex, skip), {0, 0}});
+    std::sort(facets.begin(), facets.end(),
+              [](const FacetEntry& a, const FacetEntry& b) { return a.key < b.key; });
+    for (const uint32_t simplex : list)
+      if (!(store_.flags(dimension, simplex) & SimplexStore::kUndecided)) countDecided(dimension, simplex);
+  }
   return list;
 }
 
+VertexSplitter::FacetEntry& VertexSplitter::facetOf(int dimension, uint32_t simplex, int skip) {
+  std::vector<FacetEntry>& facets = facets_[size_t(dimension)];
+  const FacetKey key = facetKey(dimension, simplex, skip);
+  // The first entry of the facet's run holds its counts; every simplex of
+  // the list has its facets in the index.
+  return *std::lower_bound(facets.begin(), facets.end(), key,
+                           [](const FacetEntry& entry, const FacetKey& k) { return entry.key < k; });
+}
+
+// The orientation a simplex induces on its facet without the vertex at
+// `skip`: its parity and the rank of that vertex.
+int VertexSplitter::inducedSign(int dimension, uint32_t simplex, int skip) const {
+  const uint32_t* v = store_.vertices(dimension, simplex);
+  return store_.parity(dimension, simplex) ^ (rankOf(v, dimension + 1, v[skip]) & 1);
+}
+
+void VertexSplitter::countDecided(int dimension, uint32_t simplex) {
+  for (int skip = 0; skip <= dimension; ++skip)
+    ++facetOf(dimension, simplex, skip).decided[inducedSign(dimension, simplex, skip)];
+}
+
+bool VertexSplitter::isFaceOfHigher(int dimension, uint32_t simplex) {
+  if (dimension >= SimplexStore::kMaxDimension) return false;
+  // around() lists at most two simplices per star entry: a smaller star
+  // gets no index.
+  if (star_.size() * 2 > kIndexedStar) {
+    around(dimension + 1);
+    const std::vector<FacetEntry>& facets = facets_[size_t(dimension) + 1];
+    if (!facets.empty()) {
+      const FacetKey key = facetKey(dimension, simplex, dimension + 1);
+      const auto at = std::lower_bound(facets.begin(), facets.end(), key,
+                                       [](const FacetEntry& entry, const FacetKey& k) { return entry.key < k; });
+      return at != facets.end() && !(key < at->key);
+    }
+  }
+  const uint32_t* mine = store_.vertices(dimension, simplex);
+  return std::as_const(store_).forEachIncident(dimension + 1, newVertex_, [&](uint32_t candidate, uint32_t) {
+    const uint32_t* theirs = store_.vertices(dimension + 1, candidate);
+    bool all = true;
+    for (int i = 0; i <= dimension; ++i) all &= containsVertex(theirs, dimension + 2, mine[i]);
+    return all;
+  });
+}
+
+// The vertices of a simplex but the one at `skip` (all of them when `skip`
+// is past the last; at most three either way), ascending, as one key: the
+// first two ids in one word, the third, or 0, in the other.
+VertexSplitter::FacetKey VertexSplitter::facetKey(int dimension, uint32_t simplex, int skip) const {
+  const uint32_t* v = store_.vertices(dimension, simplex);
+  uint32_t facet[3] = {0, 0, 0};
+  int n = 0;
+  for (int i = 0; i <= dimension; ++i)
+    if (i != skip) facet[n++] = v[i];
+  std::sort(facet, facet + n);
+  return {uint64_t(facet[0]) << 32 | facet[1], facet[2]};
+}
+
 // The vote of predictFlip for simplices of kArity vertices, the arity known
-// at compile time so that the comparisons unroll without branches.
+// at compile time so that the comparisons unroll without branches. A
+// neighbour is a decided simplex one vertex apart (sharing a facet), and
+// it votes for the orientation that makes the two consistent.
 template <int kArity>
-int VertexSplitter::voteOnFlip(uint32_t simplex, const std::vector<uint32_t>& candidates, int& voteClass) const {
+int VertexSplitter::voteOnFlip(uint32_t simplex, const std::vector<uint32_t>& candidates, int& voteClass) {
   constexpr int kDimension = kArity - 1;
   const uint32_t* mine = store_.vertices(kDimension, simplex);
   const int myParity = store_.parity(kDimension, simplex);
   int keep = 0, flip = 0;
-  for (const uint32_t other : candidates) {
-    if (other == simplex || (store_.flags(kDimension, other) & SimplexStore::kUndecided)) continue;
+  auto vote = [&](uint32_t other) {
+    if (other == simplex || (store_.flags(kDimension, other) & SimplexStore::kUndecided)) return;
     const uint32_t* theirs = store_.vertices(kDimension, other);
     // Neighbours share all vertices but one each; most candidates share
     // only the split's vertex, so theirs are looked at only after mine.
@@ -521,7 +595,7 @@ int VertexSplitter::voteOnFlip(uint32_t simplex, const std::vector<uint32_t>& ca
     for (int i = 0; i < kArity; ++i) mineShared |= int(containsVertex(theirs, kArity, mine[i])) << i;
     constexpr int kAll = (1 << kArity) - 1;
     const int mineOnly = kAll ^ mineShared;
-    if (mineOnly & (mineOnly - 1) || mineOnly == 0) continue;  // not exactly one vertex apart
+    if (mineOnly & (mineOnly - 1) || mineOnly == 0) return;  // not exactly one vertex apart
     for (int i = 0; i < kArity; ++i) theirsShared |= int(containsVertex(mine, kArity, theirs[i])) << i;
     const int theirsOnly = kAll ^ theirsShared;
     // Orientation each induces on the shared facet; consistent neighbours
@@ -533,6 +607,18 @@ int VertexSplitter::voteOnFlip(uint32_t simplex, const std::vector<uint32_t>& ca
       ++flip;
     else
       ++keep;
+  };
+  if (facets_[size_t(kDimension)].empty()) {
+    for (const uint32_t other : candidates) vote(other);
+  } else {
+    // The same count: two distinct simplices share at most one facet, and
+    // the simplex being decided is not counted yet.
+    for (int skip = 0; skip < kArity; ++skip) {
+      const std::array<uint32_t, 2>& decided = facetOf(kDimension, simplex, skip).decided;
+      const int mySign = inducedSign(kDimension, simplex, skip);
+      flip += int(decided[size_t(mySign)]);
+      keep += int(decided[size_t(1 - mySign)]);
+    }
   }
   voteClass = keep + flip == 0 ? 0 : (keep == 0 || flip == 0) ? 1 : 2;
   return flip > keep;

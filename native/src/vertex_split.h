@@ -191,7 +191,7 @@ class VertexSplitter {
   void decideOrientation(Coder& coder, int dimension, uint32_t simplex, bool isCopy, uint8_t target);
   int predictFlip(int dimension, uint32_t simplex, int& voteClass);
   template <int kArity>
-  int voteOnFlip(uint32_t simplex, const std::vector<uint32_t>& candidates, int& voteClass) const;
+  int voteOnFlip(uint32_t simplex, const std::vector<uint32_t>& candidates, int& voteClass);
 
   SimplexStore& store_;
   PositionPredictor& geometry_;
@@ -214,6 +214,34 @@ class VertexSplitter {
   std::array<std::vector<uint32_t>, 4> around_;
   std::array<bool, 4> aroundReady_{};
   const std::vector<uint32_t>& around(int dimension);
+  // Per dimension, for stars of more than kIndexedStar simplices around: the
+  // facets of around()'s simplices, sorted by key (the facet's vertices,
+  // ascending), the first entry of each facet's run counting the decided
+  // simplices that induce each orientation on it.
+  struct FacetKey {
+    uint64_t low;
+    uint32_t high;
+    bool operator<(const FacetKey& o) const { return low != o.low ? low < o.low : high < o.high; }
+  };
+  struct FacetEntry {
+    FacetKey key;
+    std::array<uint32_t, 2> decided;
+  };
+  FacetKey facetKey(int dimension, uint32_t simplex, int skip) const;
+  FacetEntry& facetOf(int dimension, uint32_t simplex, int skip);
+  int inducedSign(int dimension, uint32_t simplex, int skip) const;
+  // Adds a simplex whose orientation is decided to its facets' counts.
+  void countDecided(int dimension, uint32_t simplex);
+  // Below this many simplices around, a vote polls them all: building the
+  // index costs more than it saves.
+  static constexpr size_t kIndexedStar = 256;
+  // Whether a simplex made by the split (so holding v2) is a face of one of
+  // dimension + 1: looked up in the index, or found in v2's list, rather
+  // than in the list of another of its vertices, which may be in very many
+  // simplices outside the split.
+  bool isFaceOfHigher(int dimension, uint32_t simplex);
+  uint32_t newVertex_ = kNoSimplex;  // v2 of the split under way
+  std::array<std::vector<FacetEntry>, 4> facets_;
   // Code models: [dimension][possible set][step of the sequential binarisation].
   BitModel codeModels_[4][16][3];
   // Whether v and v2 are joined (the vertex's code, 3 or 4) by the shape of
@@ -277,7 +305,7 @@ void VertexSplitter::decideOrientation(Coder& coder, int dimension, uint32_t sim
                                        uint8_t target) {
   int voteClass = 0;
   const int predicted = predictFlip(dimension, simplex, voteClass);
-  const int faceOfHigher = store_.isFace(dimension, simplex);
+  const int faceOfHigher = isFaceOfHigher(dimension, simplex);
   int flip = predicted;
   if (target != split_record::kFree)
     flip = store_.parity(dimension, simplex) != target - split_record::kParity0;
@@ -287,12 +315,14 @@ void VertexSplitter::decideOrientation(Coder& coder, int dimension, uint32_t sim
   uint8_t& flags = store_.flags(dimension, simplex);
   if (flip) flags ^= SimplexStore::kFlipped;
   flags &= uint8_t(~SimplexStore::kUndecided);
+  if (!facets_[size_t(dimension)].empty()) countDecided(dimension, simplex);
   ++statistics_.orientationBits;
   statistics_.orientationMispredicted += mispredicted;
 }
 
 template <class Coder, class Oracle>
 bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int balance, Oracle&& oracle) {
+  newVertex_ = v2;
   gatherStar(store_, v, star_, begin_);
   linkFans();
   classifyEdges(v, level);

@@ -145,6 +145,25 @@ inline std::array<uint32_t, 3> positionBits(const Complex& c, uint32_t v) {
   return bits;
 }
 
+// Two fans of `rim` triangles (or, with `solid`, of tetrahedra over a disc
+// fanned from its centre) around two apexes a hair apart, sharing their
+// rim: the apexes merge late, each with a star of about 2 · rim simplices,
+// and the split that separates them copies every one.
+inline Complex doubleFan(int rim, bool solid) {
+  Complex c;
+  c.positions = {0, 0, 1e-5f, 0, 0, -1e-5f, 0, 0, 0};
+  for (int i = 0; i < rim; ++i) {
+    const double angle = 2 * M_PI * i / rim;
+    c.positions.insert(c.positions.end(), {float(std::cos(angle)), float(std::sin(angle)), 0.0f});
+  }
+  for (uint32_t i = 0; i < uint32_t(rim); ++i) {
+    const uint32_t a = 3 + i, b = 3 + (i + 1) % uint32_t(rim);
+    if (solid) c.tetrahedra.insert(c.tetrahedra.end(), {0, 2, a, b, 1, 2, b, a});
+    else c.triangles.insert(c.triangles.end(), {0, a, b, 1, b, a});
+  }
+  return c;
+}
+
 // Drops degenerate, duplicate and non-maximal simplices like the encoder
 // does, then names vertices by position. Edges have no orientation.
 inline std::vector<OrientedSimplex> canonicalForm(const Complex& c) {

@@ -257,6 +257,22 @@ TEST(CoarsePlacement, PredictedVerticesStayInTheirCellsAndComeCloserToTheModel) 
   }
 }
 
+// Splits whose stars hold over a thousand simplices take the indexed paths of
+// the orientation vote and of the snapshots' face tests.
+TEST(Connectivity, StarsOfOverAThousandSimplicesRoundTripInEveryPrefix) {
+  EncodeOptions o = exact();
+  o.chunkBytes = 256;
+  for (const bool solid : {false, true}) {
+    const Complex input = doubleFan(600, solid);
+    const EncodeResult encoded = encode(input, o);
+    ASSERT_TRUE(encoded.status.ok()) << encoded.status.message;
+    Complex output;
+    ASSERT_TRUE(decode(encoded.bytes.data(), encoded.bytes.size(), output).ok());
+    EXPECT_EQ(canonicalForm(output), canonicalForm(input)) << (solid ? "tetrahedra" : "triangles");
+    expectPrefixesAreProjections(input, o);
+  }
+}
+
 TEST(Connectivity, EveryChunkPrefixIsTheProjectionOfTheInput) {
   EncodeOptions o = exact();
   o.chunkBytes = 64;
