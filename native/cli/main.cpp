@@ -148,7 +148,19 @@ struct EncodeArgs {
   size_t chunkBytes = 16 * 1024;
   bool pointsOnly = false;
   bool weld = false;
+  // Encoder memory limit in bytes; 0 for none, kMachineMemory for three
+  // quarters of the machine's memory.
+  static constexpr uint64_t kMachineMemory = UINT64_MAX;
+  uint64_t maxMemory = kMachineMemory;
 };
+
+// Three quarters of the machine's physical memory, or 0 (no limit) where
+// the system does not say.
+uint64_t defaultMemoryLimit() {
+  const long pages = sysconf(_SC_PHYS_PAGES), pageSize = sysconf(_SC_PAGE_SIZE);
+  if (pages <= 0 || pageSize <= 0) return 0;
+  return uint64_t(pages) * uint64_t(pageSize) / 4 * 3;
+}
 
 int runEncode(const EncodeArgs& args) {
   const auto start = Clock::now();
@@ -173,11 +185,14 @@ int runEncode(const EncodeArgs& args) {
   options.bits = args.bits;
   options.exact = args.exact;
   options.chunkBytes = args.chunkBytes;
+  options.maxMemoryBytes = args.maxMemory == EncodeArgs::kMachineMemory ? defaultMemoryLimit() : args.maxMemory;
   ProgressLine progress;
   options.progress = [&](const kdmesh::EncodeProgress& p) { progress.update(p.phase, p.fraction); };
   const auto encodeStart = Clock::now();
   kdmesh::EncodeResult result = kdmesh::encode(complex, options);
   const double encodeSeconds = secondsSince(encodeStart);
+  if (result.status.code == kdmesh::ErrorCode::LimitExceeded)
+    result.status.message += " (--max-memory raises it)";
   if (!result.status.ok()) return fail(result.status, "cannot encode " + args.input);
   std::string error;
   if (!writeBytes(args.output, result.bytes, error)) return fail(error);
@@ -475,6 +490,10 @@ int main(int argc, char** argv) {
                    "Drop edges, triangles and tetrahedra and encode the vertices");
   encode->add_flag("--weld", encodeArgs.weld,
                    "Merge vertices with bit-identical positions (for STL triangle soups)");
+  encode->add_option("--max-memory", encodeArgs.maxMemory,
+                     "Refuse inputs whose encoding would take more memory than this (e.g. 4GB; 0: no "
+                     "limit; default: three quarters of the machine's memory)")
+      ->transform(CLI::AsSizeValue(false));
 
   DecodeArgs decodeArgs;
   CLI::App* decode = app.add_subcommand("decode", "Decompress a .kdm file (or a prefix of it)");

@@ -39,7 +39,17 @@ Status checkOptions(const Complex& complex, const EncodeOptions& options) {
     return Status::error(ErrorCode::InvalidInput, "the input has no vertices");
   if (complex.vertexCount() >= (size_t(1) << 31))
     return Status::error(ErrorCode::InvalidInput, "more than 2^31 - 1 vertices");
-  return checkAttributes(complex);
+  if (Status status = checkAttributes(complex); !status.ok()) return status;
+  const uint64_t needed = encodeMemoryEstimate(complex);
+  if (options.maxMemoryBytes != 0 && needed > options.maxMemoryBytes)
+    return Status::error(ErrorCode::LimitExceeded,
+                         "encoding " + std::to_string(complex.vertexCount()) + " vertices and " +
+                             std::to_string(complex.edges.size() / 2 + complex.triangles.size() / 3 +
+                                            complex.tetrahedra.size() / 4) +
+                             " simplices needs about " + std::to_string(needed >> 20) +
+                             " MiB of working memory, more than the limit of " +
+                             std::to_string(options.maxMemoryBytes >> 20) + " MiB");
+  return Status::success();
 }
 
 // Writes chunks into the stream body: a frame, then the payload that the
@@ -221,6 +231,17 @@ void exportModels(PositionPredictor& predictor, CountCoder& counts, VertexSplitt
 }
 
 }  // namespace
+
+uint64_t encodeMemoryEstimate(const Complex& complex) {
+  // Peak resident bytes per vertex and per listed edge, triangle and
+  // tetrahedron (their faces included), fitted to kdmesh encode runs.
+  constexpr uint64_t kPerVertex = 110, kPerEdge = 150, kPerTriangle = 200, kPerTetrahedron = 360;
+  uint64_t bytes = uint64_t(complex.vertexCount()) * kPerVertex + uint64_t(complex.edges.size() / 2) * kPerEdge +
+                   uint64_t(complex.triangles.size() / 3) * kPerTriangle +
+                   uint64_t(complex.tetrahedra.size() / 4) * kPerTetrahedron;
+  for (const VertexAttribute& attribute : complex.attributes) bytes += attribute.values.size();
+  return bytes;
+}
 
 EncodeResult encode(const Complex& complex, const EncodeOptions& options) {
   return encode(complex, options, nullptr);

@@ -495,6 +495,24 @@ TEST_F(CliTest, ATwoGigabyteAllZeroStlWeldsInLittleMemory) {
   fs::remove(at("zeros.stl"));
 }
 
+// Without --weld an all-zero STL keeps three vertices per triangle: its
+// encoding would take about 2.9 GB here, so a 1 GiB limit refuses it once
+// read, before the encoder allocates anything.
+TEST_F(CliTest, AnEncodeOverTheMemoryLimitIsRefusedBeforeAllocating) {
+  const uint32_t triangles = uint32_t(((uintmax_t(256) << 20) - 84) / 50);
+  writeSparse("zeros.stl", stlPrefix(triangles), 84 + uintmax_t(50) * triangles);
+  Usage usage;
+  const CliRun r = runMeasured("encode zeros.stl -o zeros.kdm --max-memory 1GB", usage);
+  EXPECT_EQ(r.exitCode, 1) << r.err;
+  EXPECT_NE(r.err.find("needs about 2"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("more than the limit of 1024 MiB (--max-memory raises it) [limit-exceeded]"),
+            std::string::npos)
+      << r.err;
+  EXPECT_LT(usage.residentKilobytes, 1L << 20) << "peak resident memory";
+  EXPECT_FALSE(fs::exists(at("zeros.kdm")));
+  fs::remove(at("zeros.stl"));
+}
+
 // A binary STL whose count needs more bytes than the file has is refused on
 // its first 84 bytes; one with bytes after its triangles reads the
 // triangles alone. Neither reads the rest of its 2 GiB.

@@ -78,6 +78,28 @@ TEST(HostileInputs, AMillionCoincidentVertices) {
   EXPECT_EQ(canonicalForm(d).size(), canonicalForm(fan).size());
 }
 
+// maxMemoryBytes refuses a complex by its estimate, before encoding.
+TEST(HostileInputs, TheEncoderMemoryLimitComparesTheEstimate) {
+  Complex soup;
+  for (uint32_t t = 0; t < 1000; ++t) {
+    soup.positions.insert(soup.positions.end(), {float(t), 0, 0, float(t), 1, 0, float(t), 0, 1});
+    soup.triangles.insert(soup.triangles.end(), {3 * t, 3 * t + 1, 3 * t + 2});
+  }
+  const uint64_t estimate = encodeMemoryEstimate(soup);
+  Complex point;
+  point.positions = {0, 0, 0};
+  EXPECT_GT(estimate, encodeMemoryEstimate(point));
+  EncodeOptions options;
+  options.maxMemoryBytes = estimate - 1;
+  const EncodeResult refused = encode(soup, options);
+  EXPECT_EQ(refused.status.code, ErrorCode::LimitExceeded);
+  EXPECT_NE(refused.status.message.find("3000 vertices and 1000 simplices"), std::string::npos)
+      << refused.status.message;
+  EXPECT_TRUE(refused.bytes.empty());
+  options.maxMemoryBytes = estimate;
+  EXPECT_TRUE(encode(soup, options).status.ok());
+}
+
 TEST(HostileInputs, TenMillionPoints) {
   Complex cloud;
   cloud.positions = uniformCloud(10000000, 77);

@@ -167,7 +167,17 @@ struct EncodeOptions {
   size_t chunkBytes = 16 * 1024;
   // Called now and then during long encodes; may be empty.
   std::function<void(const EncodeProgress&)> progress;
+  // Working memory encode() may take, in bytes (0: no limit). A complex
+  // whose estimate (encodeMemoryEstimate()) is larger is refused with
+  // LimitExceeded before anything is allocated.
+  uint64_t maxMemoryBytes = 0;
 };
+
+// About the peak working memory of encoding `complex`, in bytes, the
+// complex itself included: per vertex and per listed simplex of each
+// dimension, as measured on point clouds, wireframes, surfaces, soups and
+// tetrahedral meshes (docs/SECURITY.md). Within about 20 % on those.
+uint64_t encodeMemoryEstimate(const Complex& complex);
 
 // What the splits of one kd-tree level coded, in bits (CodingCost::levels).
 struct LevelCost {
