@@ -31,6 +31,9 @@
 // and the new simplex of a code 4 get one coded bit each, predicted from
 // the orientations of already decided neighbours that share a facet.
 //
+// With labels, every simplex a split creates then gets its label, in the
+// same order as the orientations (labels.h).
+//
 // One template serves both sides: on the encoder `Oracle` supplies the
 // decimation's answers and the range coder writes them; on the decoder the
 // range coder reads them and the oracle's values are ignored.
@@ -39,9 +42,11 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "kdmesh/kdmesh.h"
+#include "labels.h"
 #include "mixer.h"
 #include "model_priors.h"
 #include "position_predictor.h"
@@ -134,15 +139,23 @@ class VertexSplitter {
     visitMixer(MixerFamily::EdgeCodes, edgeMixer_);
   }
 
+  // Codes labels of `tableSize` distinct values from now on; the store
+  // must be labelled.
+  void enableLabels(uint32_t tableSize) { labels_.emplace(tableSize); }
+
   // Splits `v`, whose cell is at `level`, into `v` and `v2`; `balance`:
-  // splitBalance() of the cell's split. `next()` of the oracle gives the
-  // record byte of each star entry in canonical order.
-  // Returns false when the codes contradict each other or the store is full:
-  // corrupt data on the decoder.
-  template <class Coder, class Oracle>
-  bool split(Coder& coder, uint32_t v, uint32_t v2, int level, int balance, Oracle&& oracle);
+  // splitBalance() of the cell's split. `oracle()` gives the record byte of
+  // each star entry in canonical order, `labelOracle()` the label of each
+  // new simplex (SplitRecords::labels) when labels are enabled.
+  // Returns false when the codes contradict each other, a label is not in
+  // the table or the store is full: corrupt data on the decoder.
+  template <class Coder, class Oracle, class LabelOracle>
+  bool split(Coder& coder, uint32_t v, uint32_t v2, int level, int balance, Oracle&& oracle,
+             LabelOracle&& labelOracle);
 
   const ConnectivityStatistics& statistics() const { return statistics_; }
+  // Information content of the labels coded so far (measuring coders).
+  double labelBits() const { return labelBits_; }
 
  private:
   using Entry = StarEntry;
@@ -257,6 +270,8 @@ class VertexSplitter {
   double halfWidth_ = 0;  // of the split cell along the split axis (0: not geometric)
   // Orientation models: [dimension - 2][copy or new][vote class][face of higher].
   BitModel orientationModels_[2][2][3][2];
+  std::optional<LabelCoder> labels_;
+  double labelBits_ = 0;
   ConnectivityStatistics statistics_;
 };
 
@@ -291,8 +306,9 @@ void VertexSplitter::decideOrientation(Coder& coder, int dimension, uint32_t sim
   statistics_.orientationMispredicted += mispredicted;
 }
 
-template <class Coder, class Oracle>
-bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int balance, Oracle&& oracle) {
+template <class Coder, class Oracle, class LabelOracle>
+bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int balance, Oracle&& oracle,
+                           LabelOracle&& labelOracle) {
   gatherStar(store_, v, star_, begin_);
   linkFans();
   classifyEdges(v, level);
@@ -399,7 +415,8 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int
   for (int d = 1; d <= SimplexStore::kMaxDimension; ++d) store_.detach(d, v);
   if (star_[0].code == 4) {
     const uint32_t edge[2] = {v, v2};
-    if (store_.add(1, edge, 0) == kNoSimplex) return false;
+    star_[0].added = store_.add(1, edge, 0);
+    if (star_[0].added == kNoSimplex) return false;
   }
   for (size_t i = 1; i < star_.size(); ++i) {
     Entry& entry = star_[i];
@@ -432,6 +449,22 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int
     if (entry.added != kNoSimplex && d + 1 >= 2)
       decideOrientation(coder, d + 1, entry.added, false,
                         uint8_t((entry.record >> split_record::kNewTargetShift) & 3));
+  }
+  if (labels_) {
+    const double before = coder.cost();
+    for (const Entry& entry : star_) {
+      const int d = entry.dimension;
+      const uint32_t parent = d == 0 ? kNoLabel : store_.label(d, entry.simplex);
+      for (const bool isCopy : {true, false}) {
+        const uint32_t simplex = isCopy ? entry.copy : entry.added;
+        if (simplex == kNoSimplex) continue;
+        const int dimension = isCopy ? d : d + 1;
+        const uint32_t label = labels_->code(coder, dimension, isCopy, parent, labelOracle());
+        if (label == kNoLabel) return false;
+        store_.label(dimension, simplex) = label;
+      }
+    }
+    labelBits_ += coder.cost() - before;
   }
   return true;
 }
