@@ -11,6 +11,7 @@
 #include "complexes.h"
 #include "container.h"
 #include "crc32.h"
+#include "kdmesh/io.h"
 #include "kdmesh/kdmesh.h"
 #include "labels.h"
 
@@ -340,6 +341,122 @@ TEST(Labels, TruncatedTableIsIncomplete) {
     ASSERT_TRUE(decoder.push(encoded.bytes.data(), cut).ok());
     EXPECT_EQ(decoder.finish().code, ErrorCode::Truncated);
     EXPECT_TRUE(decoder.snapshot().labels.empty());
+  }
+}
+
+Complex readText(io::Format format, const std::string& text, io::Notes& notes) {
+  Complex out;
+  const Status status =
+      io::readMemory(format, reinterpret_cast<const uint8_t*>(text.data()), text.size(), out, notes);
+  EXPECT_TRUE(status.ok()) << status.message;
+  return out;
+}
+
+std::string joined(const io::Notes& notes) {
+  std::string all;
+  for (const std::string& note : notes) all += note + "\n";
+  return all;
+}
+
+TEST(LabelFiles, PlyFaceProperty) {
+  const std::string ply =
+      "ply\nformat ascii 1.0\nelement vertex 5\nproperty float x\nproperty float y\nproperty float z\n"
+      "element face 2\nproperty list uchar int vertex_indices\nproperty short material_index\n"
+      "property float quality\nend_header\n"
+      "0 0 0\n1 0 0\n1 1 0\n0 1 0\n2 0 0\n"
+      "4 0 1 2 3 -3 0.5\n3 1 4 2 7 0.25\n";
+  io::Notes notes;
+  const Complex c = readText(io::Format::Ply, ply, notes);
+  EXPECT_EQ(c.labels.triangles, (std::vector<int32_t>{-3, -3, 7}));  // the quadrilateral's two triangles
+  EXPECT_NE(joined(notes).find("quality"), std::string::npos) << joined(notes);
+  EXPECT_EQ(joined(notes).find("material_index"), std::string::npos) << joined(notes);
+  for (const bool ascii : {true, false}) {
+    std::vector<uint8_t> bytes;
+    io::WriteOptions options;
+    options.asciiPly = ascii;
+    ASSERT_TRUE(io::writeMemory(io::Format::Ply, c, bytes, options).ok());
+    io::Notes again;
+    Complex back;
+    ASSERT_TRUE(io::readMemory(io::Format::Ply, bytes.data(), bytes.size(), back, again).ok());
+    EXPECT_EQ(back.labels.triangles, c.labels.triangles);
+    EXPECT_EQ(back.triangles, c.triangles);
+  }
+}
+
+TEST(LabelFiles, PlyLabelsOfEveryDimension) {
+  Complex c = tetrahedralBlock(1, 2);
+  const uint32_t n = uint32_t(c.vertexCount());
+  c.positions.insert(c.positions.end(), {5.f, 5.f, 5.f, 6.f, 5.f, 5.f});
+  c.triangles = {n, n + 1, 0};
+  c.edges = {n + 1, 1};
+  labelBySlabs(c, 3);
+  std::vector<uint8_t> bytes;
+  ASSERT_TRUE(io::writeMemory(io::Format::Ply, c, bytes).ok());
+  io::Notes notes;
+  Complex back;
+  ASSERT_TRUE(io::readMemory(io::Format::Ply, bytes.data(), bytes.size(), back, notes).ok());
+  EXPECT_EQ(back.labels.edges, c.labels.edges);
+  EXPECT_EQ(back.labels.triangles, c.labels.triangles);
+  EXPECT_EQ(back.labels.tetrahedra, c.labels.tetrahedra);
+}
+
+TEST(LabelFiles, MeditReferences) {
+  const std::string mesh =
+      "MeshVersionFormatted 1\nDimension 3\nVertices\n6\n"
+      "0 0 0 1\n1 0 0 0\n0 1 0 0\n0 0 1 0\n1 1 1 0\n3 3 3 0\n"
+      "Tetrahedra\n2\n1 2 3 4 5\n2 3 4 5 6\n"
+      "Triangles\n2\n1 2 3 9\n4 5 6 8\n"  // the first is a face of a tetrahedron
+      "Edges\n1\n1 6 2\nEnd\n";
+  io::Notes notes;
+  const Complex c = readText(io::Format::Medit, mesh, notes);
+  EXPECT_EQ(c.labels.tetrahedra, (std::vector<int32_t>{5, 6}));
+  EXPECT_EQ(c.labels.triangles, (std::vector<int32_t>{9, 8}));
+  EXPECT_EQ(c.labels.edges, (std::vector<int32_t>{2}));
+  EXPECT_NE(joined(notes).find("references of 1 vertices"), std::string::npos) << joined(notes);
+  EXPECT_NE(joined(notes).find("dropped the nonzero references of 1 edges and triangles"), std::string::npos)
+      << joined(notes);
+  // Through the codec: the face's reference goes, the others stay.
+  const EncodeResult encoded = encode(c, exactOptions());
+  ASSERT_TRUE(encoded.status.ok());
+  const Complex decoded = decodeOrFail(encoded.bytes);
+  EXPECT_EQ(labelledForm(decoded), labelledForm(c));
+  EXPECT_EQ(decoded.labels.triangles, std::vector<int32_t>{8});
+  std::vector<uint8_t> bytes;
+  ASSERT_TRUE(io::writeMemory(io::Format::Medit, decoded, bytes).ok());
+  io::Notes again;
+  Complex back;
+  ASSERT_TRUE(io::readMemory(io::Format::Medit, bytes.data(), bytes.size(), back, again).ok());
+  EXPECT_EQ(labelledForm(back), labelledForm(decoded));
+}
+
+TEST(LabelFiles, MeditZeroReferencesAreNoLabels) {
+  const std::string mesh =
+      "MeshVersionFormatted 1\nDimension 3\nVertices\n3\n0 0 0 0\n1 0 0 0\n0 1 0 0\n"
+      "Triangles\n1\n1 2 3 0\nEnd\n";
+  io::Notes notes;
+  EXPECT_TRUE(readText(io::Format::Medit, mesh, notes).labels.empty());
+}
+
+TEST(LabelFiles, TetgenRegionAttribute) {
+  Complex c = tetrahedralBlock(2, 6);
+  labelBySlabs(c, 3);
+  const std::string dir = ::testing::TempDir();
+  ASSERT_TRUE(io::writeFile(dir + "/labels_region.node", c).ok());
+  io::Notes notes;
+  Complex back;
+  ASSERT_TRUE(io::readFile(dir + "/labels_region.node", back, notes).ok());
+  EXPECT_EQ(back.labels.tetrahedra, c.labels.tetrahedra);
+  EXPECT_EQ(joined(notes).find("region"), std::string::npos) << joined(notes);
+}
+
+TEST(LabelFiles, FormatsWithoutLabelsRefuse) {
+  Complex c = sphereMesh(5, 6);
+  labelBySlabs(c, 2);
+  for (const io::Format format : {io::Format::Obj, io::Format::Off, io::Format::Vtk}) {
+    std::vector<uint8_t> bytes;
+    const Status status = io::writeMemory(format, c, bytes);
+    EXPECT_EQ(status.code, ErrorCode::InvalidArgument) << io::formatName(format);
+    EXPECT_NE(status.message.find("labels"), std::string::npos) << status.message;
   }
 }
 
