@@ -452,6 +452,12 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int
   }
   if (labels_) {
     const double before = coder.cost();
+    // Whether the star's simplices of each dimension had more than one
+    // label: a split inside a region makes simplices of its label.
+    std::array<bool, 4> mixed{};
+    for (int d = 1; d <= 3; ++d)
+      for (size_t i = begin_[size_t(d)] + 1; i < begin_[size_t(d) + 1] && !mixed[size_t(d)]; ++i)
+        mixed[size_t(d)] = store_.label(d, star_[i].simplex) != store_.label(d, star_[begin_[size_t(d)]].simplex);
     for (const Entry& entry : star_) {
       const int d = entry.dimension;
       const uint32_t parent = d == 0 ? kNoLabel : store_.label(d, entry.simplex);
@@ -459,7 +465,8 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int
         const uint32_t simplex = isCopy ? entry.copy : entry.added;
         if (simplex == kNoSimplex) continue;
         const int dimension = isCopy ? d : d + 1;
-        const uint32_t label = labels_->code(coder, dimension, isCopy, parent, labelOracle());
+        const uint32_t label =
+            labels_->code(coder, dimension, isCopy, mixed[size_t(dimension)], parent, labelOracle());
         if (label == kNoLabel) return false;
         store_.label(dimension, simplex) = label;
       }
