@@ -164,7 +164,8 @@ struct Decoder::State {
                              where + ": more splits than the kd-tree has cells");
       if (cursor < cells.size()) {
         if (!splitCell(cells[cursor++]))
-          return Status::error(ErrorCode::CorruptChunk, where + ": inconsistent connectivity codes");
+          return Status::error(ErrorCode::CorruptChunk,
+                               where + ": inconsistent connectivity codes or a label outside the table");
         --left;
       } else {
         const size_t count = std::min<size_t>(left, singleLevelEnd - singleCursor);
@@ -368,7 +369,12 @@ struct Decoder::State {
         const size_t at = list.size();
         list.insert(list.end(), v, v + d + 1);
         if (store.flags(d, simplex) & SimplexStore::kFlipped) std::swap(list[at], list[at + 1]);
-        if (header.labelled) labels.push_back(labelTable[store.label(d, simplex)]);
+        if (header.labelled) {
+          // A split that failed on corrupt data may have left a simplex
+          // without a label: a snapshot after the error still shows it.
+          const uint32_t index = store.label(d, simplex);
+          labels.push_back(index < labelTable.size() ? labelTable[index] : 0);
+        }
       }
     }
     for (uint32_t v = 0; v < nextVertex; ++v)

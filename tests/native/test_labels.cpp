@@ -325,8 +325,14 @@ TEST(Labels, IndexBeyondTheTableIsCorrupt) {
   ASSERT_TRUE(encoded.status.ok());
   // Three labels code their indices in two bits like four: index 3 has no label.
   std::string message;
-  EXPECT_EQ(decodeError(withLabelTable(encoded.bytes, {3, 9, 6, 6}), &message), ErrorCode::CorruptChunk);
+  const std::vector<uint8_t> corrupt = withLabelTable(encoded.bytes, {3, 9, 6, 6});
+  EXPECT_EQ(decodeError(corrupt, &message), ErrorCode::CorruptChunk);
   EXPECT_FALSE(message.empty());
+  // The model as far as it got stays readable, a label per simplex.
+  Decoder decoder;
+  EXPECT_EQ(decoder.push(corrupt.data(), corrupt.size()).code, ErrorCode::CorruptChunk);
+  const Complex partial = decoder.snapshot();
+  EXPECT_EQ(partial.labels.triangles.size(), partial.triangles.size() / 3);
 }
 
 TEST(Labels, TruncatedTableIsIncomplete) {
