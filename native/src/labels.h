@@ -5,13 +5,13 @@
 // Labels are coded as indices into the table (the sorted distinct labels).
 // A split creates simplices by codes 3 and 4 (the copy of a star simplex,
 // and the simplex one dimension up on it); each new simplex gets one
-// adaptive bit "same label as its parent" (the star simplex it comes from),
-// with models by its dimension, by copy or added, and by whether the split
-// vertex's star held simplices of that dimension with different labels
-// (the vertex's new edge has no parent and skips the bit), and otherwise
-// its index in the table by
-// a bit tree of adaptive models over the index's leading bits, the rest at
-// probability 1/2. A table of one label codes nothing.
+// adaptive bit "same label as its parent" (the star simplex it comes from;
+// for the vertex's new edge, the star's first edge), with models by its
+// dimension, by copy or added, and by whether the split vertex's star held
+// simplices of that dimension with different labels; if not, one bit
+// "the star's other label" when the star has one; and otherwise its index
+// in the table by a bit tree of adaptive models over the index's leading
+// bits, the rest at probability 1/2. A table of one label codes nothing.
 #pragma once
 
 #include <cstdint>
@@ -56,16 +56,20 @@ class LabelCoder {
 
   // Decides the label of a new simplex of `dimension` from its parent's
   // (kNoLabel: no parent); `mixed`: the split vertex's star held simplices
-  // of that dimension with different labels. On the encoder `recorded` is the label it must
+  // of that dimension with different labels; `other`: a label of the star
+  // other than the parent's (kNoLabel: none), the likely one when the
+  // parent's is not. On the encoder `recorded` is the label it must
   // get, or kNoLabel when any will do; the decoder ignores it. Returns the
   // label, or kNoLabel for an index outside the table (corrupt data).
   template <class Coder>
-  uint32_t code(Coder& coder, int dimension, bool isCopy, bool mixed, uint32_t parent, uint32_t recorded) {
+  uint32_t code(Coder& coder, int dimension, bool isCopy, bool mixed, uint32_t parent, uint32_t other,
+                uint32_t recorded) {
     if (tableSize_ <= 1) return 0;
     const bool hasParent = parent != kNoLabel;
     const bool same = hasParent && (recorded == kNoLabel || recorded == parent);
     if (hasParent && coder.bit(sameModels_[dimension - 1][isCopy][mixed], same)) return parent;
-    if (recorded == kNoLabel) recorded = 0;  // no parent, and any label will do
+    if (recorded == kNoLabel) recorded = other != kNoLabel ? other : 0;  // no parent, and any label will do
+    if (other != kNoLabel && coder.bit(otherModels_[dimension - 1][isCopy], recorded == other)) return other;
     // Index bits, most significant first: a tree over the top ones.
     uint32_t index = 0, node = 1;
     for (int b = indexBits_ - 1; b >= indexBits_ - treeBits_; --b) {
@@ -84,6 +88,8 @@ class LabelCoder {
   int treeBits_ = 0;
   // [dimension - 1][copy or added][mixed star]
   BitModel sameModels_[3][2][2];
+  // [dimension - 1][copy or added]
+  BitModel otherModels_[3][2];
   std::vector<BitModel> tree_;  // node 1 is the root, node n's children 2n, 2n + 1
 };
 

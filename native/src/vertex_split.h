@@ -454,19 +454,32 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int
     const double before = coder.cost();
     // Whether the star's simplices of each dimension had more than one
     // label: a split inside a region makes simplices of its label.
+    // The first two labels of each dimension in the star: a new simplex
+    // that does not take its parent's label likely takes the other.
     std::array<bool, 4> mixed{};
-    for (int d = 1; d <= 3; ++d)
-      for (size_t i = begin_[size_t(d)] + 1; i < begin_[size_t(d) + 1] && !mixed[size_t(d)]; ++i)
-        mixed[size_t(d)] = store_.label(d, star_[i].simplex) != store_.label(d, star_[begin_[size_t(d)]].simplex);
+    std::array<std::array<uint32_t, 2>, 4> seen;
+    for (int d = 1; d <= 3; ++d) {
+      seen[size_t(d)] = {kNoLabel, kNoLabel};
+      if (begin_[size_t(d)] == begin_[size_t(d) + 1]) continue;
+      seen[size_t(d)][0] = store_.label(d, star_[begin_[size_t(d)]].simplex);
+      for (size_t i = begin_[size_t(d)] + 1; i < begin_[size_t(d) + 1] && !mixed[size_t(d)]; ++i) {
+        const uint32_t label = store_.label(d, star_[i].simplex);
+        mixed[size_t(d)] = label != seen[size_t(d)][0];
+        seen[size_t(d)][1] = label;
+      }
+    }
     for (const Entry& entry : star_) {
       const int d = entry.dimension;
-      const uint32_t parent = d == 0 ? kNoLabel : store_.label(d, entry.simplex);
+      // The new edge v v2 has no parent: it takes the star's first edge's place.
+      const uint32_t parent = d == 0 ? seen[1][0] : store_.label(d, entry.simplex);
       for (const bool isCopy : {true, false}) {
         const uint32_t simplex = isCopy ? entry.copy : entry.added;
         if (simplex == kNoSimplex) continue;
         const int dimension = isCopy ? d : d + 1;
+        const std::array<uint32_t, 2>& both = seen[size_t(dimension)];
+        const uint32_t other = both[0] != parent ? both[0] : mixed[size_t(dimension)] ? both[1] : kNoLabel;
         const uint32_t label =
-            labels_->code(coder, dimension, isCopy, mixed[size_t(dimension)], parent, labelOracle());
+            labels_->code(coder, dimension, isCopy, mixed[size_t(dimension)], parent, other, labelOracle());
         if (label == kNoLabel) return false;
         store_.label(dimension, simplex) = label;
       }
