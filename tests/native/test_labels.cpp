@@ -14,6 +14,8 @@
 #include "kdmesh/io.h"
 #include "kdmesh/kdmesh.h"
 #include "labels.h"
+#include "mutations.h"
+#include "test_support.h"
 
 namespace kdmesh::test {
 namespace {
@@ -333,6 +335,34 @@ TEST(Labels, IndexBeyondTheTableIsCorrupt) {
   EXPECT_EQ(decoder.push(corrupt.data(), corrupt.size()).code, ErrorCode::CorruptChunk);
   const Complex partial = decoder.snapshot();
   EXPECT_EQ(partial.labels.triangles.size(), partial.triangles.size() / 3);
+}
+
+// Header fields, chunk order and payload bytes of a labelled stream changed
+// (checksums made valid again): clean errors, or a complex with one label
+// per simplex.
+TEST(Labels, MutatedLabelledStreamsFailCleanly) {
+  Complex c = tetrahedralBlock(3, 8);
+  labelBySlabs(c, 5);
+  EncodeOptions o;
+  o.bits = 10;
+  o.chunkBytes = 256;
+  const std::vector<MutatedStream> streams = mutatedStreams(encodeOrDie(c, o), 300, 31);
+  ASSERT_EQ(streams.size(), 300u);
+  int failed = 0;
+  for (size_t trial = 0; trial < streams.size(); ++trial) {
+    Complex out;
+    const Status s = decode(streams[trial].bytes.data(), streams[trial].bytes.size(), out);
+    if (s.ok()) {
+      for (int d = 1; d <= 3; ++d) EXPECT_EQ(out.labels.of(d).size(), out.simplexCount(d)) << trial;
+      continue;
+    }
+    ++failed;
+    EXPECT_TRUE(s.code == ErrorCode::CorruptHeader || s.code == ErrorCode::CorruptChunk ||
+                s.code == ErrorCode::LimitExceeded || s.code == ErrorCode::TrailingBytes ||
+                s.code == ErrorCode::Truncated)
+        << trial << " (" << streams[trial].kind << "): " << errorCodeName(s.code) << " " << s.message;
+  }
+  EXPECT_GT(failed, 0);
 }
 
 TEST(Labels, TruncatedTableIsIncomplete) {
