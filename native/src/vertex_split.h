@@ -452,10 +452,10 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int
   }
   if (labels_) {
     const double before = coder.cost();
-    // Whether the star's simplices of each dimension had more than one
-    // label: a split inside a region makes simplices of its label.
-    // The first two labels of each dimension in the star: a new simplex
-    // that does not take its parent's label likely takes the other.
+    // Per dimension, whether the star's simplices had more than one label
+    // (a split inside a region makes simplices of its label), and the
+    // first two labels (a new simplex that does not take its parent's
+    // likely takes the other).
     std::array<bool, 4> mixed{};
     std::array<std::array<uint32_t, 2>, 4> seen;
     for (int d = 1; d <= 3; ++d) {

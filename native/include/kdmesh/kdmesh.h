@@ -207,7 +207,7 @@ struct LevelCost {
   int axis = 0;
   uint32_t cells = 0;  // cells the level split: the model's vertices before it
   double geometryBits = 0;
-  double connectivityBits = 0;
+  double connectivityBits = 0;  // simplex labels included
 };
 
 // Information content of what a stream codes, in bits: the sum of -log2(p)
