@@ -23,6 +23,7 @@ if [ -z "$(ls "$corpus/decoder")" ]; then
   ./build/kdmesh encode tests/fuzz/seeds/mixed.obj -o "$corpus/decoder/mixed.kdm" --exact -q
   ./build/kdmesh encode tests/fuzz/seeds/tetrahedra.mesh -o "$corpus/decoder/tetrahedra.kdm" --bits 6 -q
   ./build/kdmesh encode tests/fuzz/seeds/colours.ply -o "$corpus/decoder/attributes.kdm" --exact -q
+  ./build/kdmesh encode tests/fuzz/seeds/regions.mesh -o "$corpus/decoder/labels.kdm" --exact -q
   # Reader seeds: the first byte picks the format (see fuzz_readers.cpp).
   for seed in tests/fuzz/seeds/*; do
     case "$seed" in

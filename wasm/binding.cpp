@@ -65,6 +65,7 @@ void visitHeader(const kdmesh::Header& h, Field&& field) {
   field("chunkCount", Values{double(h.chunkCount)});
   field("depth", Values{double(h.depth())});  // kd-tree levels: the last level of a complete stream
   field("attributeCount", Values{double(h.attributeCount)});
+  field("labelled:bool", Values{h.labelled ? 1.0 : 0.0});
 }
 
 template <class Field>
@@ -193,6 +194,14 @@ EMSCRIPTEN_KEEPALIVE int kdm_attribute_components(KdmDecoder* d, uint32_t a) {
 }
 EMSCRIPTEN_KEEPALIVE const uint8_t* kdm_attribute_values(KdmDecoder* d, uint32_t a) {
   return d->snapshot.attributes[a].values.data();
+}
+// The snapshot's labels of the simplices of dimension 1..3: as many as
+// simplices, or none when the stream has no labels.
+EMSCRIPTEN_KEEPALIVE uint32_t kdm_label_count(KdmDecoder* d, int dimension) {
+  return uint32_t(d->snapshot.labels.of(dimension).size());
+}
+EMSCRIPTEN_KEEPALIVE const int32_t* kdm_labels(KdmDecoder* d, int dimension) {
+  return d->snapshot.labels.of(dimension).data();
 }
 EMSCRIPTEN_KEEPALIVE uint32_t kdm_parent_count(KdmDecoder* d) { return uint32_t(d->decoder.vertexParents().size()); }
 EMSCRIPTEN_KEEPALIVE const uint32_t* kdm_parents(KdmDecoder* d) { return d->decoder.vertexParents().data(); }

@@ -152,8 +152,14 @@ function sendSnapshot() {
   const attributes = {};
   for (const [name, { array, itemSize }] of Object.entries(live.attributes))
     attributes[name] = { array: pack(array.constructor, [array], vertexCount * itemSize)[0], itemSize };
+  // Simplex labels (labelled streams): copies, as the views into the
+  // decoder's memory must not be posted (a view posts its whole buffer).
+  const labels = live.labels && {
+    edges: live.labels.edges.slice(), triangles: live.labels.triangles.slice(),
+    tetrahedra: live.labels.tetrahedra.slice(),
+  };
   const model = {
-    ...live, positions, points, edges, triangles, tetrahedra: live.tetrahedra.slice(), attributes,
+    ...live, positions, points, edges, triangles, tetrahedra: live.tetrahedra.slice(), attributes, labels,
     boundary: boundaryInPlace, tetrahedronEdges: tetrahedronEdgesInPlace,
     bounds: bounds(positions),
     normals: streamNormals(attributes) ??
@@ -166,7 +172,7 @@ function sendSnapshot() {
   job.decodeMs = 0;
   job.handOverMs = performance.now() - began;
   const buffers = [positions, points, edges, triangles, model.tetrahedra, model.normals, model.parents,
-    ...Object.values(attributes).map((a) => a.array)]
+    ...Object.values(attributes).map((a) => a.array), ...(labels ? Object.values(labels) : [])]
     .map((a) => a.buffer).filter((b, i, all) => b.byteLength && all.indexOf(b) === i);
   postMessage({ type: 'snapshot', model }, buffers);
   if (model.complete) end();

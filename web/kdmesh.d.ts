@@ -47,6 +47,8 @@ export interface Header {
   depth: number;
   /** Vertex attributes the stream carries (their names arrive with the first snapshot). */
   attributeCount: number;
+  /** Whether edges, triangles and tetrahedra carry integer labels (Model.labels). */
+  labelled: boolean;
 }
 
 /** A vertex attribute's values: vertexCount · itemSize of its type, as a three.js BufferAttribute takes them. */
@@ -81,6 +83,9 @@ export interface Model {
   tetrahedra: Uint32Array;
   /** Vertex attributes by name (colours, normals, texture coordinates, ...), exact at every level. */
   attributes: Record<string, VertexAttribute>;
+  /** Streams with simplex labels only: one label (material, region, group id) per simplex of each list,
+   * exact once complete; a coarse simplex shows the label of an input simplex it stands for. */
+  labels?: { edges: Int32Array; triangles: Int32Array; tetrahedra: Int32Array };
   complete: boolean;
   stats: { bytes: number; level: number; chunks: number; errorBound: number; bitsPerVertex: number };
 }

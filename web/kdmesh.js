@@ -241,7 +241,9 @@ export class Decoder {
 
   /**
    * The model at the current level: { vertexCount, positions, points, edges,
-   * triangles, tetrahedra, attributes, complete, stats }. `attributes` maps
+   * triangles, tetrahedra, attributes, labels?, complete, stats }. `labels`
+   * (streams with simplex labels only) holds { edges, triangles, tetrahedra },
+   * an Int32Array of one label per simplex of each list. `attributes` maps
    * each vertex attribute's name to { array, itemSize } (a typed array of
    * vertexCount · itemSize values, the type's own: Uint8Array for uint8, ...). With { copy: false } the arrays
    * are views of WebAssembly memory, valid only until the next call on this
@@ -268,7 +270,7 @@ export class Decoder {
       attributes[m.UTF8ToString(m._kdm_attribute_name(h, a))] = { array, itemSize };
     }
     const progress = this.progress;
-    return {
+    const model = {
       vertexCount,
       positions,
       points: indices(0),
@@ -285,6 +287,14 @@ export class Decoder {
         bitsPerVertex: vertexCount ? (8 * progress.bytesConsumed) / vertexCount : 0,
       },
     };
+    if (this.header?.labelled) {
+      const labels = (dimension) => {
+        const count = m._kdm_label_count(h, dimension);
+        return count ? take(new Int32Array(m.HEAPU8.buffer, m._kdm_labels(h, dimension), count)) : new Int32Array(0);
+      };
+      model.labels = { edges: labels(1), triangles: labels(2), tetrahedra: labels(3) };
+    }
+    return model;
   }
 
   /**

@@ -282,6 +282,13 @@ int runDecode(const DecodeArgs& args) {
     note(args.output + ": left out the vertex attributes " + names + ", which " + formatName + " cannot hold");
     complex.attributes.clear();
   }
+  // PLY, Medit and TetGen hold simplex labels.
+  if (outputFormat != kdmesh::io::Format::Ply && outputFormat != kdmesh::io::Format::Medit &&
+      outputFormat != kdmesh::io::Format::TetGen && outputFormat != kdmesh::io::Format::Unknown &&
+      !complex.labels.empty()) {
+    note(args.output + ": left out the simplex labels, which " + formatName + " cannot hold");
+    complex.labels = {};
+  }
   if (auto s = kdmesh::io::writeFile(args.output, complex, writeOptions); !s.ok())
     return fail(s, args.output);
   if (!gQuiet)
@@ -307,6 +314,14 @@ std::string jsonNumber(double v) {
   char buffer[64];
   std::snprintf(buffer, sizeof buffer, "%.17g", v);
   return buffer;
+}
+
+// How many distinct labels the simplices of a complex carry.
+size_t distinctLabels(const kdmesh::Complex& complex) {
+  std::vector<int32_t> labels;
+  for (int d = 1; d <= 3; ++d) labels.insert(labels.end(), complex.labels.of(d).begin(), complex.labels.of(d).end());
+  std::sort(labels.begin(), labels.end());
+  return size_t(std::unique(labels.begin(), labels.end()) - labels.begin());
 }
 
 int runInfo(const std::string& input, bool json, bool perLevel) {
@@ -337,6 +352,8 @@ int runInfo(const std::string& input, bool json, bool perLevel) {
                   jsonNumber(h.origin[1]).c_str(), jsonNumber(h.origin[2]).c_str(),
                   jsonNumber(h.step).c_str());
     const kdmesh::Complex final = decoder.snapshot();
+    std::printf("  \"labels\": {\"distinct\": %zu, \"bitsPerVertex\": %s},\n", distinctLabels(final),
+                jsonNumber(cost.labelBits / n).c_str());
     std::printf("  \"attributes\": [");
     for (size_t a = 0; a < final.attributes.size(); ++a)
       std::printf("%s{\"name\": \"%s\", \"type\": \"%s\", \"components\": %u, \"bitsPerVertex\": %s}",
@@ -392,10 +409,18 @@ int runInfo(const std::string& input, bool json, bool perLevel) {
   std::printf("kd-tree levels  %d\n", h.depth());
   double attributeBits = 0;
   for (const double bits : cost.attributeBits) attributeBits += bits;
-  std::printf("bits/vertex     %.3f total: %.3f geometry, %.3f connectivity, %.3f attributes, %.3f container\n",
+  std::printf("bits/vertex     %.3f total: %.3f geometry, %.3f connectivity, %.3f attributes, %.3f labels, "
+              "%.3f container\n",
               8.0 * double(bytes.size()) / n, cost.geometryBits / n, cost.connectivityBits / n, attributeBits / n,
-              (8.0 * double(bytes.size()) - cost.geometryBits - cost.connectivityBits - attributeBits) / n);
+              cost.labelBits / n,
+              (8.0 * double(bytes.size()) - cost.geometryBits - cost.connectivityBits - attributeBits - cost.labelBits) /
+                  n);
   const kdmesh::Complex final = decoder.snapshot();
+  if (h.labelled) {
+    const size_t simplices = final.labels.edges.size() + final.labels.triangles.size() + final.labels.tetrahedra.size();
+    std::printf("labels          %zu distinct, %.3f bits/vertex, %.3f bits/simplex\n", distinctLabels(final),
+                cost.labelBits / n, simplices ? cost.labelBits / double(simplices) : 0.0);
+  }
   for (size_t a = 0; a < final.attributes.size(); ++a)
     std::printf("%s%s (%u %s) %.3f bits/vertex\n", a == 0 ? "attributes      " : "                ",
                 oneLine(final.attributes[a].name).c_str(), unsigned(final.attributes[a].components),

@@ -15,8 +15,9 @@ static_assert(kHeaderPrefixBytes == kOffHeaderBytes + 1, "header prefix");
 // The fixed bytes, ten 32-bit varints (the body size's has at most 9 bytes),
 // grid parameters (float32 mode's are three 32-bit varints) and checksum.
 static_assert(kMaxHeaderBytes == kHeaderPrefixBytes + 2 + 9 * 5 + 9 + 20 + 4, "header size");
-// The mode byte: quantization in bits 0-1, the highest dimension in bits
-// 2-3, the number of vertex attributes in bits 4-7.
+// The mode byte: quantization in bit 0, whether simplices carry labels in
+// bit 1, the highest dimension in bits 2-3, the number of vertex attributes
+// in bits 4-7.
 static_assert(kMaxAttributes == 15, "the attribute count has four bits");
 
 void put16(uint8_t* p, uint16_t v) {
@@ -29,28 +30,6 @@ void put32(uint8_t* p, uint32_t v) {
 uint16_t get16(const uint8_t* p) { return uint16_t(p[0] | p[1] << 8); }
 uint32_t get32(const uint8_t* p) {
   return uint32_t(p[0]) | uint32_t(p[1]) << 8 | uint32_t(p[2]) << 16 | uint32_t(p[3]) << 24;
-}
-
-// Unsigned LEB128: seven bits per byte, low first, the high bit set on every
-// byte but the last.
-size_t putVarint(uint8_t* p, uint64_t v) {
-  size_t n = 0;
-  for (; v >= 0x80; v >>= 7) p[n++] = uint8_t(v | 0x80);
-  p[n++] = uint8_t(v);
-  return n;
-}
-
-// Reads a varint of at most `maxBytes` bytes from [at, end): Incomplete if
-// `end` comes first, Malformed if it is longer or above `limit`.
-Parsed readVarint(const uint8_t*& at, const uint8_t* end, size_t maxBytes, uint64_t limit, uint64_t& v) {
-  v = 0;
-  for (size_t i = 0; i < maxBytes; ++i) {
-    if (at == end) return Parsed::Incomplete;
-    const uint8_t byte = *at++;
-    v |= uint64_t(byte & 0x7f) << (7 * i);
-    if (!(byte & 0x80)) return v <= limit ? Parsed::Complete : Parsed::Malformed;
-  }
-  return Parsed::Malformed;
 }
 
 // IEEE-754 values as the little-endian bytes of their bit patterns.
@@ -118,6 +97,7 @@ Status validate(const Header& h, const DecoderLimits& limits) {
                              " vertices, more than the decoder limit of " +
                              std::to_string(limits.maxVertices));
   if (h.maxDimension > 3) return corrupt("simplex dimension above 3");
+  if (h.labelled && h.maxDimension == 0) return corrupt("labels without simplices");
   for (size_t d = size_t(h.maxDimension) + 1; d <= 3; ++d)
     if (h.simplexCounts[d] != 0) return corrupt("simplices above the maximum dimension");
   if (h.maxDimension > 0 && h.simplexCounts[h.maxDimension] == 0)
@@ -156,6 +136,8 @@ Status validate(const Header& h, const DecoderLimits& limits) {
   // Vertices of a stream with attributes are told apart by splits, also
   // coincident ones; each attribute takes at least 5 bytes of the table.
   if (h.attributeCount > 0 && h.vertexCount > 1 && h.chunkCount == 0) return corrupt("stream has no chunks");
+  // Labels need simplices, which need splits.
+  if (h.labelled && h.chunkCount == 0) return corrupt("stream has no chunks");
   if (h.bodyBytes < uint64_t(h.attributeCount) * 5 + (h.attributeCount > 0 ? 4 : 0))
     return corrupt("the body cannot hold the attribute table");
   return Status::success();
@@ -163,11 +145,31 @@ Status validate(const Header& h, const DecoderLimits& limits) {
 
 }  // namespace
 
+// Unsigned LEB128: seven bits per byte, low first, the high bit set on every
+// byte but the last.
+size_t putVarint(uint8_t* p, uint64_t v) {
+  size_t n = 0;
+  for (; v >= 0x80; v >>= 7) p[n++] = uint8_t(v | 0x80);
+  p[n++] = uint8_t(v);
+  return n;
+}
+
+Parsed readVarint(const uint8_t*& at, const uint8_t* end, size_t maxBytes, uint64_t limit, uint64_t& v) {
+  v = 0;
+  for (size_t i = 0; i < maxBytes; ++i) {
+    if (at == end) return Parsed::Incomplete;
+    const uint8_t byte = *at++;
+    v |= uint64_t(byte & 0x7f) << (7 * i);
+    if (!(byte & 0x80)) return v <= limit ? Parsed::Complete : Parsed::Malformed;
+  }
+  return Parsed::Malformed;
+}
+
 size_t writeHeader(const Header& h, uint8_t* out) {
   std::memcpy(out, kMagic, 4);
   put16(out + kOffVersion, kFormatVersion);
   uint8_t* at = out + kHeaderPrefixBytes;
-  *at++ = uint8_t(uint8_t(h.quantization) | h.maxDimension << 2 | h.attributeCount << 4);
+  *at++ = uint8_t(uint8_t(h.quantization) | h.labelled << 1 | h.maxDimension << 2 | h.attributeCount << 4);
   *at++ = h.bits;
   at += putVarint(at, h.vertexCount);
   for (const uint32_t count : h.simplexCounts) at += putVarint(at, count);
@@ -212,7 +214,8 @@ Status readHeader(const uint8_t* in, size_t size, const DecoderLimits& limits, H
   const uint8_t* const end = in + size - 4;
   if (end - at < 2) return corrupt("truncated fields");
   const uint8_t mode = *at++;
-  h.quantization = Quantization(mode & 3);
+  h.quantization = Quantization(mode & 1);
+  h.labelled = mode >> 1 & 1;
   h.maxDimension = uint8_t(mode >> 2 & 3);
   h.attributeCount = uint8_t(mode >> 4);
   h.bits = *at++;

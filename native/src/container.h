@@ -12,7 +12,17 @@
 
 namespace kdmesh {
 
-constexpr uint16_t kFormatVersion = 18;
+constexpr uint16_t kFormatVersion = 19;
+
+// What a read of bytes that may not all have arrived found.
+enum class Parsed { Complete, Incomplete, Malformed };
+
+// Unsigned LEB128: seven bits per byte, low first, the high bit set on every
+// byte but the last. Writes at most 10 bytes and returns how many.
+size_t putVarint(uint8_t* p, uint64_t v);
+// Reads a varint of at most `maxBytes` bytes from [at, end): Incomplete if
+// `end` comes first, Malformed if it is longer or above `limit`.
+Parsed readVarint(const uint8_t*& at, const uint8_t* end, size_t maxBytes, uint64_t limit, uint64_t& v);
 
 // Writes the header (its headerBytes field is ignored) and returns its size.
 size_t writeHeader(const Header& header, uint8_t* out /* kMaxHeaderBytes */);
@@ -45,8 +55,6 @@ size_t writeChunkFrame(const ChunkFrame& frame, uint8_t* out /* kMaxChunkFrameBy
 // those bytes, so that a chunk moved, dropped or repeated fails it.
 void writeChunkChecksum(const uint8_t* chunk, size_t checked, uint32_t index, uint8_t* out /* kChunkChecksumBytes */);
 bool chunkChecksumMatches(const uint8_t* chunk, size_t checked, uint32_t index);
-// What a read of bytes that may not all have arrived found.
-enum class Parsed { Complete, Incomplete, Malformed };
 // Reads the frame at the start of in[0..available); `size` gets its size.
 Parsed readChunkFrame(const uint8_t* in, size_t available, ChunkFrame& frame, size_t& size);
 

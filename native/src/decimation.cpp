@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <string>
 
+#include "labels.h"
 #include "vertex_split.h"
 
 namespace kdmesh {
@@ -34,6 +35,27 @@ void addMissingFaces(SimplexStore& store, int d, const uint32_t* v) {
 // only code and targets.
 constexpr uint8_t kHasCopy = 0x40, kHasAdded = 0x80;
 
+// Merges record per-split runs last split first; this lays them out in split
+// order. reversed holds split k's run at offset (total - begin[k + 1]).
+template <class T>
+void layOutInSplitOrder(const std::vector<T>& reversed, const std::vector<uint64_t>& length, std::vector<T>& out,
+                        std::vector<uint64_t>& begin) {
+  const size_t splits = length.size();
+  begin.resize(splits + 1);
+  out.resize(reversed.size());
+  uint64_t at = 0;
+  for (size_t k = 0; k < splits; ++k) {
+    begin[k] = at;
+    at += length[k];
+  }
+  begin[splits] = at;
+  for (size_t k = 0; k < splits; ++k) {
+    const uint64_t from = at - begin[k + 1];
+    std::copy(reversed.begin() + std::ptrdiff_t(from), reversed.begin() + std::ptrdiff_t(from + length[k]),
+              out.begin() + std::ptrdiff_t(begin[k]));
+  }
+}
+
 }  // namespace
 
 Status buildInputComplex(const Complex& complex, const std::vector<uint32_t>& ids,
@@ -41,6 +63,8 @@ Status buildInputComplex(const Complex& complex, const std::vector<uint32_t>& id
   const size_t n = complex.vertexCount();
   summary = InputSummary{};
   store.reset(uint32_t(n), true);
+  std::vector<int32_t> table = labelTable(complex);
+  if (!table.empty()) store.enableLabels();
   const std::vector<uint32_t>* lists[4] = {&complex.points, &complex.edges, &complex.triangles,
                                            &complex.tetrahedra};
   for (int d = 0; d <= 3; ++d) {
@@ -74,7 +98,11 @@ Status buildInputComplex(const Complex& complex, const std::vector<uint32_t>& id
         ++(listed ? summary.repairs.duplicate : summary.repairs.redundant)[size_t(d)];
         continue;
       }
-      store.add(d, v, SimplexStore::kMeaningful);
+      const uint32_t label =
+          table.empty() ? kNoLabel
+                        : uint32_t(std::lower_bound(table.begin(), table.end(), labelOf(complex, d, i / arity)) -
+                                   table.begin());
+      store.add(d, v, SimplexStore::kMeaningful, label);
       ++summary.maximal[size_t(d)];
       summary.maxDimension = std::max(summary.maxDimension, d);
       if (d >= 2) addMissingFaces(store, d, v);
@@ -82,6 +110,24 @@ Status buildInputComplex(const Complex& complex, const std::vector<uint32_t>& id
   }
   for (uint32_t point : complex.points)
     if (store.hasIncident(1, ids[point])) ++summary.repairs.redundant[0];
+  if (!table.empty()) {
+    // Only labels of kept simplices go to the stream's table.
+    std::vector<uint32_t> renamed(table.size(), 0);
+    for (int d = 1; d <= 3; ++d)
+      for (uint32_t s = 0; s < store.size(d); ++s)
+        if (store.label(d, s) != kNoLabel) renamed[store.label(d, s)] = 1;
+    uint32_t kept = 0;
+    for (size_t i = 0; i < table.size(); ++i) {
+      const bool used = renamed[i] != 0;
+      renamed[i] = kept;
+      if (used) table[kept++] = table[i];
+    }
+    table.resize(kept);
+    for (int d = 1; d <= 3; ++d)
+      for (uint32_t s = 0; s < store.size(d); ++s)
+        if (store.label(d, s) != kNoLabel) store.label(d, s) = renamed[store.label(d, s)];
+    summary.labelTable = std::move(table);
+  }
   for (uint32_t v = 0; v < n; ++v) summary.maximal[0] += !store.hasIncident(1, v);
   return Status::success();
 }
@@ -90,20 +136,36 @@ void decimate(SimplexStore& store, const std::vector<VertexSplitIds>& splits,
               SplitRecords& records, const std::function<void(double)>& progress) {
   std::array<std::vector<uint8_t>, 4> scratch;  // record bytes under construction
   for (int d = 1; d <= 3; ++d) scratch[size_t(d)].assign(store.size(d), 0);
+  // With labels, the labels of each simplex's copy and added simplex.
+  const bool labelled = store.labelled();
+  std::array<std::vector<uint32_t>, 4> copyLabel, addedLabel;
+  if (labelled)
+    for (int d = 1; d <= 3; ++d) {
+      copyLabel[size_t(d)].assign(store.size(d), kNoLabel);
+      addedLabel[size_t(d)].assign(store.size(d), kNoLabel);
+    }
+  // A simplex whose label is free takes the label of the simplex that the
+  // decoder makes from it: it is then that simplex's likely prediction.
+  auto inherit = [&store](int d, uint32_t simplex, uint32_t label) {
+    uint32_t& mine = store.label(d, simplex);
+    if (mine == kNoLabel) mine = label;
+  };
   std::vector<uint32_t> star2;
   std::vector<StarEntry> star;
   std::array<size_t, 5> begin{};
   records.bytes.clear();
   // Merges are recorded last split first, into `reversed`; each split's
   // length turns into its forward `begin` at the end.
-  std::vector<uint64_t> recordLength(splits.size());
+  std::vector<uint64_t> recordLength(splits.size()), labelLength(labelled ? splits.size() : 0);
   std::vector<uint8_t> reversed;
+  std::vector<uint32_t> reversedLabels;
 
   for (size_t k = splits.size(); k-- > 0;) {
     if (progress && (k & 0xffff) == 0) progress(1.0 - double(k) / double(splits.size()));
     const uint32_t v1 = splits[k].kept, v2 = splits[k].added;
     const uint32_t edge[2] = {v1, v2};
     const bool joined = store.find(1, edge) != kNoSimplex;
+    uint32_t joiningLabel = kNoLabel;  // of the edge v1 v2
 
     for (int d = 1; d <= 3; ++d) {
       star2.clear();
@@ -123,6 +185,12 @@ void decimate(SimplexStore& store, const std::vector<VertexSplitIds>& splits,
             const uint32_t parent = store.find(d - 1, face);
             scratch[size_t(d - 1)][parent] |=
                 uint8_t(kHasAdded | (target << split_record::kNewTargetShift));
+            if (labelled) {
+              addedLabel[size_t(d - 1)][parent] = store.label(d, s);
+              inherit(d - 1, parent, store.label(d, s));
+            }
+          } else if (labelled) {
+            joiningLabel = store.label(d, s);
           }
           store.kill(d, s);
           continue;
@@ -141,6 +209,10 @@ void decimate(SimplexStore& store, const std::vector<VertexSplitIds>& splits,
         }
         // Both have it: code 3 (or 4, marked by the simplex one dimension up).
         scratch[size_t(d)][twin] |= uint8_t(kHasCopy | (target << split_record::kCopyTargetShift));
+        if (labelled) {
+          copyLabel[size_t(d)][twin] = store.label(d, s);
+          inherit(d, twin, store.label(d, s));
+        }
         uint8_t& twinFlags = store.flags(d, twin);
         if (d >= 2 && meaningful && !(twinFlags & SimplexStore::kMeaningful)) {
           // The coarse simplex takes the orientation of the one that matters.
@@ -155,31 +227,26 @@ void decimate(SimplexStore& store, const std::vector<VertexSplitIds>& splits,
     gatherStar(store, v1, star, begin);
     const size_t first = reversed.size();
     reversed.push_back(joined ? 3 : 2);
+    const size_t firstLabel = reversedLabels.size();
+    if (labelled && joined) reversedLabels.push_back(joiningLabel);
     for (size_t i = 1; i < star.size(); ++i) {
-      uint8_t& bits = scratch[star[i].dimension][star[i].simplex];
+      const int d = star[i].dimension;
+      const uint32_t simplex = star[i].simplex;
+      uint8_t& bits = scratch[size_t(d)][simplex];
       const uint8_t code = (bits & kHasAdded) ? 3 : (bits & kHasCopy) ? 2 : (bits & split_record::kCodeMask);
       reversed.push_back(uint8_t(code | (bits & 0x3c)));
+      if (labelled) {
+        if (bits & kHasCopy) reversedLabels.push_back(copyLabel[size_t(d)][simplex]);
+        if (bits & kHasAdded) reversedLabels.push_back(addedLabel[size_t(d)][simplex]);
+      }
       bits = 0;
     }
     recordLength[k] = reversed.size() - first;
+    if (labelled) labelLength[k] = reversedLabels.size() - firstLabel;
   }
 
-  // Lay the records out in split order.
-  records.begin.resize(splits.size() + 1);
-  records.bytes.resize(reversed.size());
-  uint64_t at = 0;
-  for (size_t k = 0; k < splits.size(); ++k) {
-    records.begin[k] = at;
-    at += recordLength[k];
-  }
-  records.begin[splits.size()] = at;
-  // `reversed` holds split k's records at offset (total - begin[k+1]).
-  for (size_t k = 0; k < splits.size(); ++k) {
-    const uint64_t length = recordLength[k];
-    const uint64_t from = at - records.begin[k + 1];
-    std::copy(reversed.begin() + std::ptrdiff_t(from), reversed.begin() + std::ptrdiff_t(from + length),
-              records.bytes.begin() + std::ptrdiff_t(records.begin[k]));
-  }
+  layOutInSplitOrder(reversed, recordLength, records.bytes, records.begin);
+  if (labelled) layOutInSplitOrder(reversedLabels, labelLength, records.labels, records.labelBegin);
 }
 
 }  // namespace kdmesh

@@ -25,19 +25,29 @@ struct InputSummary {
   std::array<uint32_t, 4> maximal{};  // kept simplices per dimension; [0] isolated vertices
   int maxDimension = 0;
   InputRepairs repairs;
+  // The sorted distinct labels of the kept simplices; empty without labels.
+  std::vector<int32_t> labelTable;
 };
 
 // Fills `store` with the closure of the input's simplices, with vertex i of
 // the input renamed ids[i]. Listed simplices are flagged kMeaningful (their
-// orientation is data); faces added by the closure are not.
+// orientation is data); faces added by the closure are not. With labels,
+// listed simplices get the index of theirs in summary.labelTable, faces
+// added by the closure kNoLabel.
 Status buildInputComplex(const Complex& complex, const std::vector<uint32_t>& ids,
                          SimplexStore& store, InputSummary& summary);
 
 // Per split, in the decoder's order, one record byte per star entry of the
 // split vertex (see split_record in vertex_split.h).
+// With labels, also the label (table index, or kNoLabel: any) of every
+// simplex the split creates, in the order the splitter decides them: for
+// each star entry in canonical order, its copy's, then its added simplex's
+// (the vertex entry's added simplex is the edge v1 v2).
 struct SplitRecords {
   std::vector<uint8_t> bytes;
   std::vector<uint64_t> begin;  // first byte of each split's records
+  std::vector<uint32_t> labels;
+  std::vector<uint64_t> labelBegin;  // first label of each split's
 };
 
 // Merges the vertices of `splits` from the last split to the first.

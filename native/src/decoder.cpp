@@ -10,6 +10,7 @@
 #include "container.h"
 #include "count_coder.h"
 #include "kdmesh/kdmesh.h"
+#include "labels.h"
 #include "position_predictor.h"
 #include "quantizer.h"
 #include "range_coder.h"
@@ -83,6 +84,10 @@ struct Decoder::State {
   std::optional<AttributeCoder> attributeCoder;
   bool attributeTableRead = false;
   std::vector<uint32_t> neighbours;  // of the vertex whose attributes are decoded
+  // Simplex labels: the table after the attribute table; the store holds
+  // indices into it.
+  std::vector<int32_t> labelTable;
+  bool labelTableRead = false;
   SimplexStore store;
   std::optional<VertexSplitter> splitter;
   std::optional<PositionPredictor> predictor;
@@ -104,7 +109,8 @@ struct Decoder::State {
   explicit State(const DecoderOptions& o) : options(o) {}
 
   bool complete() const {
-    return hasHeader && attributeTableRead && level >= schedule->levels && (!named || cells.empty());
+    return hasHeader && attributeTableRead && labelTableRead && level >= schedule->levels &&
+           (!named || cells.empty());
   }
 
   Status fail(Status status) {
@@ -119,6 +125,7 @@ struct Decoder::State {
     connectivity = header.maxDimension > 0;
     named = connectivity || header.attributeCount > 0;
     attributeTableRead = header.attributeCount == 0;
+    labelTableRead = !header.labelled;
     counts.emplace(schedule->levels, connectivity);
     coder.setMeasuring(options.measureCost);
     const Cell root{{0, 0, 0}, header.vertexCount, 0, 0, 0};
@@ -128,6 +135,7 @@ struct Decoder::State {
       // Vertex lists grow with the vertices actually decoded, not with the
       // count a (possibly hostile) header announces.
       store.reset(std::min<uint32_t>(header.vertexCount, 1024), false);
+      if (header.labelled) store.enableLabels();
       const std::array<uint64_t, 4> caps = simplexCaps(header);
       // The header's counts cap the pools; memory is reserved up front only
       // in proportion to the bytes already received (a whole file pushed at
@@ -158,7 +166,8 @@ struct Decoder::State {
                              where + ": more splits than the kd-tree has cells");
       if (cursor < cells.size()) {
         if (!splitCell(cells[cursor++]))
-          return Status::error(ErrorCode::CorruptChunk, where + ": inconsistent connectivity codes");
+          return Status::error(ErrorCode::CorruptChunk,
+                               where + ": inconsistent connectivity codes or a label outside the table");
         --left;
       } else {
         const size_t count = std::min<size_t>(left, singleLevelEnd - singleCursor);
@@ -172,7 +181,7 @@ struct Decoder::State {
       return Status::error(ErrorCode::CorruptChunk, where + ": undecodable data");
     double attributeBits = 0;
     for (const double bits : cost.attributeBits) attributeBits += bits;
-    cost.geometryBits = coder.cost() - cost.connectivityBits - attributeBits;
+    cost.geometryBits = coder.cost() - cost.connectivityBits - cost.labelBits - attributeBits;
     if (complete() && connectivity) return checkFinalCounts();
     return Status::success();
   }
@@ -214,11 +223,13 @@ struct Decoder::State {
     if (connectivity && !oneSided) {
       if (added >= store.vertexCapacity())
         store.growVertices(std::min<uint32_t>(header.vertexCount, 2 * store.vertexCapacity()));
-      const double before = coder.cost();
+      const double before = coder.cost(), labelsBefore = splitter->labelBits();
       if (!splitter->split(coder, cell.vertex, added, level, splitBalance(population, firstHalf, geometric),
-                           [] { return uint8_t(0); }))
+                           [] { return uint8_t(0); }, [] { return kNoLabel; }))
         return false;
-      cost.connectivityBits += coder.cost() - before;
+      const double labelBits = splitter->labelBits() - labelsBefore;
+      cost.labelBits += labelBits;
+      cost.connectivityBits += coder.cost() - before - labelBits;
     }
     if (!attributes.empty() && !oneSided) decodeAttributes(cell.vertex, added);
     for (const uint32_t half : {firstHalf, population - firstHalf}) {
@@ -277,7 +288,7 @@ struct Decoder::State {
     // The level split its cells and, at geometric levels, its one-vertex cells.
     if (options.measureCost)
       levelCosts.close(*schedule, level, uint32_t(cells.size() + (level < schedule->levels ? singleLevelEnd : 0)),
-                       coder.cost(), cost.connectivityBits, cost.levels);
+                       coder.cost(), cost.connectivityBits + cost.labelBits, cost.levels);
     // Merge from the back, so that each one-vertex cell moves once.
     size_t old = singles.size(), out = old + newSingles.size();
     singles.resize(out);
@@ -368,6 +379,7 @@ struct Decoder::State {
     std::vector<uint32_t>* lists[4] = {nullptr, &out.edges, &out.triangles, &out.tetrahedra};
     for (int d = 1; d <= 3; ++d) {
       std::vector<uint32_t>& list = *lists[d];
+      std::vector<int32_t>& labels = out.labels.of(d);
       // Once complete, the header says how many simplices of a dimension
       // are maximal: none, or all of them, spares the test (a pure triangle
       // mesh has no maximal edges and only maximal triangles).
@@ -377,6 +389,7 @@ struct Decoder::State {
       // A simplex can be a face only while simplices one dimension up exist.
       const bool testFaces = d < 3 && store.liveCount(d + 1) > 0 && (!finished || maximal != store.liveCount(d));
       list.reserve(size_t(finished ? maximal : store.liveCount(d)) * size_t(d + 1));
+      if (header.labelled) labels.reserve(finished ? maximal : store.liveCount(d));
       const std::vector<uint8_t>& isFace = !testFaces ? scratch.isFace
                                            : d == 1      ? facesOfHigher<1>(scratch.edgeFacets)
                                                          : facesOfHigher<2>(scratch.triangleFacets);
@@ -387,6 +400,12 @@ struct Decoder::State {
         const size_t at = list.size();
         list.insert(list.end(), v, v + d + 1);
         if (store.flags(d, simplex) & SimplexStore::kFlipped) std::swap(list[at], list[at + 1]);
+        if (header.labelled) {
+          // A split that failed on corrupt data may have left a simplex
+          // without a label: a snapshot after the error still shows it.
+          const uint32_t index = store.label(d, simplex);
+          labels.push_back(index < labelTable.size() ? labelTable[index] : 0);
+        }
       }
     }
     for (uint32_t v = 0; v < nextVertex; ++v)
@@ -501,6 +520,7 @@ struct Decoder::State {
     // Emptied, not replaced: a caller that snapshots level after level into
     // one Complex reuses its memory.
     for (std::vector<uint32_t>* list : {&out.points, &out.edges, &out.triangles, &out.tetrahedra}) list->clear();
+    for (int d = 1; d <= 3; ++d) out.labels.of(d).clear();
     out.positions.clear();
     if (!hasHeader) return;
     const bool finished = complete();
@@ -539,6 +559,8 @@ struct Decoder::State {
                                         &finalComplex.tetrahedra};
       std::vector<uint32_t>* to[4] = {&out.points, &out.edges, &out.triangles, &out.tetrahedra};
       for (int i = 0; i < 4; ++i) *to[i] = takeFinal ? std::move(*from[i]) : *from[i];
+      for (int d = 1; d <= 3; ++d)
+        out.labels.of(d) = takeFinal ? std::move(finalComplex.labels.of(d)) : finalComplex.labels.of(d);
       return;
     }
     out.positions.reserve(size_t(cellCount()) * 3);
@@ -596,6 +618,17 @@ struct Decoder::State {
         if (header.chunkCount == 0 && bytesConsumed != header.totalBytes())
           status = Status::error(ErrorCode::CorruptHeader, "corrupt attribute table: the header announced " +
                                                                std::to_string(header.totalBytes()) + " bytes");
+        continue;
+      }
+      if (!labelTableRead) {
+        size_t tableBytes = 0;
+        const uint64_t simplices = uint64_t(header.simplexCounts[1]) + header.simplexCounts[2] + header.simplexCounts[3];
+        const Parsed read = readLabelTable(at, available, simplices, labelTable, tableBytes, status);
+        if (read != Parsed::Complete) break;
+        splitter->enableLabels(uint32_t(labelTable.size()));
+        labelTableRead = true;
+        offset += tableBytes;
+        bytesConsumed += tableBytes;
         continue;
       }
       if (chunks.size() == header.chunkCount) {

@@ -10,6 +10,7 @@
 #include "decimation.h"
 #include "encoder_internal.h"
 #include "kd_order.h"
+#include "labels.h"
 #include "kdmesh/kdmesh.h"
 #include "position_predictor.h"
 #include "quantizer.h"
@@ -39,6 +40,7 @@ Status checkOptions(const Complex& complex, const EncodeOptions& options) {
     return Status::error(ErrorCode::InvalidInput, "the input has no vertices");
   if (complex.vertexCount() >= (size_t(1) << 31))
     return Status::error(ErrorCode::InvalidInput, "more than 2^31 - 1 vertices");
+  if (Status status = checkLabels(complex); !status.ok()) return status;
   if (Status status = checkAttributes(complex); !status.ok()) return status;
   const uint64_t needed = encodeMemoryEstimate(complex);
   if (options.maxMemoryBytes != 0 && needed > options.maxMemoryBytes)
@@ -203,10 +205,11 @@ void traverseKdTree(const std::vector<KdKey>& keys, const SplitSchedule& schedul
   }
 }
 
-// Supplies the decimation's record bytes of one split, in order.
+// Supplies the decimation's records of one split, in order.
+template <class T>
 struct RecordReader {
-  const uint8_t* next;
-  uint8_t operator()() { return *next++; }
+  const T* next;
+  T operator()() { return *next++; }
 };
 
 // The final states of the models and mixers, for learning their priors
@@ -240,6 +243,9 @@ uint64_t encodeMemoryEstimate(const Complex& complex) {
                    uint64_t(complex.triangles.size() / 3) * kPerTriangle +
                    uint64_t(complex.tetrahedra.size() / 4) * kPerTetrahedron;
   for (const VertexAttribute& attribute : complex.attributes) bytes += attribute.values.size();
+  // Labels: the input's and the store's, 4 bytes each.
+  bytes += 8 * uint64_t(complex.labels.edges.size() + complex.labels.triangles.size() +
+                        complex.labels.tetrahedra.size());
   return bytes;
 }
 
@@ -270,6 +276,7 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
   // build the input complex on those names, and merge cells in the reverse
   // of the split order.
   SplitRecords records;
+  std::vector<int32_t> labelTable;  // of the kept simplices
   bool connectivity = complex.hasSimplices();
   // Vertices with attributes need ids, and coincident ones ids of their own.
   const bool named = !complex.attributes.empty();
@@ -304,6 +311,8 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
     connectivity = summary.maxDimension > 0;
     header.maxDimension = uint8_t(summary.maxDimension);
     for (size_t d = 0; d < 4; ++d) header.simplexCounts[d] = summary.maximal[d];
+    if (connectivity) labelTable = std::move(summary.labelTable);
+    header.labelled = !labelTable.empty();
     if (connectivity)
       decimate(store, splits, records, [&](double f) { report("connectivity", f); });
   }
@@ -314,6 +323,7 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
   std::vector<uint8_t> body;
   header.attributeCount = uint8_t(complex.attributes.size());
   if (named) writeAttributeTable(complex.attributes, order.vertices[0], body);
+  if (header.labelled) writeLabelTable(labelTable, body);
   AttributeCoder attributeCoder(complex.attributes);
   result.cost.attributeBits.assign(complex.attributes.size(), 0.0);
   ChunkWriter chunks(body, options.chunkBytes);
@@ -323,6 +333,10 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
   forward.reset(header.vertexCount, false);
   PositionPredictor predictor(schedule, forward);
   VertexSplitter splitter(forward, predictor);
+  if (header.labelled) {
+    forward.enableLabels();
+    splitter.enableLabels(uint32_t(labelTable.size()));
+  }
   size_t splitIndex = 0;
   double connectivityBits = 0;
   struct Coding {
@@ -361,7 +375,10 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
       if (connectivity && added != kNoSimplex) {
         const double before = coder.cost();
         splitter.split(coder, kept, added, level, splitBalance(population, firstHalf, geometric),
-                       RecordReader{&records.bytes[records.begin[splitIndex]]});
+                       RecordReader<uint8_t>{&records.bytes[records.begin[splitIndex]]},
+                       RecordReader<uint32_t>{records.labelBegin.empty()
+                                                  ? nullptr
+                                                  : records.labels.data() + records.labelBegin[splitIndex]});
         ++splitIndex;
         connectivityBits += coder.cost() - before;
       }
@@ -409,10 +426,11 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
   traverseKdTree(order.keys, schedule, connectivity || named, coding);
   header.chunkCount = chunks.finish();
   header.bodyBytes = body.size();
-  result.cost.connectivityBits = connectivityBits;
+  result.cost.labelBits = splitter.labelBits();
+  result.cost.connectivityBits = connectivityBits - result.cost.labelBits;
   double attributeBits = 0;
   for (const double bits : result.cost.attributeBits) attributeBits += bits;
-  result.cost.geometryBits = coder.cost() - connectivityBits - attributeBits;
+  result.cost.geometryBits = coder.cost() - connectivityBits - attributeBits;  // labels among connectivityBits
   result.statistics = splitter.statistics();
   if (finalModels && connectivity) exportModels(predictor, counts, splitter, *finalModels);
 

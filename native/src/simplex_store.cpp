@@ -6,6 +6,7 @@ namespace kdmesh {
 
 void SimplexStore::reset(uint32_t vertexCapacity, bool indexed) {
   indexed_ = indexed;
+  labelled_ = false;
   for (int d = 1; d <= kMaxDimension; ++d) {
     pool_[d] = Pool{};
     if (indexed) pool_[d].table.assign(16, IndexSlot{});
@@ -26,6 +27,7 @@ void SimplexStore::setCapacity(int dimension, uint32_t maxSimplices, uint32_t ex
   pool.vertices.reserve(size_t(expected) * size_t(dimension + 1));
   pool.next.reserve(size_t(expected) * size_t(dimension + 1));
   pool.flags.reserve(expected);
+  if (labelled_) pool.labels.reserve(expected);
 }
 
 // Order-independent: the sum of the vertices' mixed ids, so no sort.
@@ -73,7 +75,7 @@ void SimplexStore::insertIndex(int dimension, uint32_t simplex) {
   ++pool.tableEntries;
 }
 
-uint32_t SimplexStore::add(int dimension, const uint32_t* vertices, uint8_t flags) {
+uint32_t SimplexStore::add(int dimension, const uint32_t* vertices, uint8_t flags, uint32_t label) {
   Pool& pool = pool_[dimension];
   const uint32_t simplex = uint32_t(pool.flags.size());
   const size_t arity = size_t(dimension + 1);
@@ -81,6 +83,7 @@ uint32_t SimplexStore::add(int dimension, const uint32_t* vertices, uint8_t flag
   if (simplex >= pool.capacity || simplex >= 0xfffffff0u / arity) return kNoSimplex;
   pool.vertices.insert(pool.vertices.end(), vertices, vertices + arity);
   pool.flags.push_back(uint8_t(flags | kAlive));
+  if (labelled_) pool.labels.push_back(label);
   ++live_[dimension];
   if (indexed_) insertIndex(dimension, simplex);
   // Slots pushed one by one: resize() was an out-of-line call in the

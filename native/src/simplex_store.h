@@ -20,6 +20,10 @@
 namespace kdmesh {
 
 constexpr uint32_t kNoSimplex = 0xffffffffu;
+// A simplex's label is an index into the stream's label table; kNoLabel on
+// the encoder marks a simplex whose label is free (a face that the closure
+// added, whose label nothing depends on).
+constexpr uint32_t kNoLabel = 0xffffffffu;
 
 // Parity of the permutation that sorts the n vertex ids v[0..n) ascending:
 // 0 even, 1 odd.
@@ -45,6 +49,10 @@ class SimplexStore {
   // looks a simplex up by its vertices, so it saves the index's time and
   // memory.
   void reset(uint32_t vertexCapacity, bool indexed);
+  // Gives every simplex a label (index into the label table); only stores
+  // of labelled complexes pay for them. Call after reset(), before add().
+  void enableLabels() { labelled_ = true; }
+  bool labelled() const { return labelled_; }
   uint32_t vertexCapacity() const { return uint32_t(heads_[1].size()); }
   // Makes room for vertex ids below `count` (lists start empty).
   void growVertices(uint32_t count);
@@ -54,8 +62,9 @@ class SimplexStore {
 
   // Adds a simplex whose vertices are all distinct and that is not yet
   // present; links it into its vertices' lists. Returns its index, or
-  // kNoSimplex when the pool is at capacity.
-  uint32_t add(int dimension, const uint32_t* vertices, uint8_t flags);
+  // kNoSimplex when the pool is at capacity. `label` is kept by labelled
+  // stores only.
+  uint32_t add(int dimension, const uint32_t* vertices, uint8_t flags, uint32_t label = kNoLabel);
   // Index of the live simplex with this vertex set, or kNoSimplex (indexed
   // stores only).
   uint32_t find(int dimension, const uint32_t* vertices) const;
@@ -74,6 +83,8 @@ class SimplexStore {
   uint32_t vertexInSlot(int dimension, uint32_t slot) const { return pool_[dimension].vertices[slot]; }
   uint8_t& flags(int dimension, uint32_t simplex) { return pool_[dimension].flags[simplex]; }
   uint8_t flags(int dimension, uint32_t simplex) const { return pool_[dimension].flags[simplex]; }
+  uint32_t& label(int dimension, uint32_t simplex) { return pool_[dimension].labels[simplex]; }
+  uint32_t label(int dimension, uint32_t simplex) const { return pool_[dimension].labels[simplex]; }
   uint32_t size(int dimension) const { return uint32_t(pool_[dimension].flags.size()); }
   uint32_t liveCount(int dimension) const { return live_[dimension]; }
 
@@ -142,6 +153,7 @@ class SimplexStore {
     std::vector<uint32_t> vertices;  // dimension + 1 per simplex
     std::vector<uint32_t> next;      // next slot in the vertex list, per slot
     std::vector<uint8_t> flags;
+    std::vector<uint32_t> labels;    // labelled stores only
     std::vector<IndexSlot> table;    // open addressing
     uint32_t tableEntries = 0;       // live or not
     uint32_t capacity = 0xffffffffu;
@@ -156,6 +168,7 @@ class SimplexStore {
   std::array<std::vector<uint32_t>, 4> heads_;    // [0] unused
   std::array<uint32_t, 4> live_{};
   bool indexed_ = true;
+  bool labelled_ = false;
 };
 
 }  // namespace kdmesh

@@ -31,6 +31,9 @@
 // and the new simplex of a code 4 get one coded bit each, predicted from
 // the orientations of already decided neighbours that share a facet.
 //
+// With labels, every simplex a split creates then gets its label, in the
+// same order as the orientations (labels.h).
+//
 // One template serves both sides: on the encoder `Oracle` supplies the
 // decimation's answers and the range coder writes them; on the decoder the
 // range coder reads them and the oracle's values are ignored.
@@ -39,9 +42,11 @@
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <vector>
 
 #include "kdmesh/kdmesh.h"
+#include "labels.h"
 #include "mixer.h"
 #include "model_priors.h"
 #include "position_predictor.h"
@@ -134,15 +139,23 @@ class VertexSplitter {
     visitMixer(MixerFamily::EdgeCodes, edgeMixer_);
   }
 
+  // Codes labels of `tableSize` distinct values from now on; the store
+  // must be labelled.
+  void enableLabels(uint32_t tableSize) { labels_.emplace(tableSize); }
+
   // Splits `v`, whose cell is at `level`, into `v` and `v2`; `balance`:
-  // splitBalance() of the cell's split. `next()` of the oracle gives the
-  // record byte of each star entry in canonical order.
-  // Returns false when the codes contradict each other or the store is full:
-  // corrupt data on the decoder.
-  template <class Coder, class Oracle>
-  bool split(Coder& coder, uint32_t v, uint32_t v2, int level, int balance, Oracle&& oracle);
+  // splitBalance() of the cell's split. `oracle()` gives the record byte of
+  // each star entry in canonical order, `labelOracle()` the label of each
+  // new simplex (SplitRecords::labels) when labels are enabled.
+  // Returns false when the codes contradict each other, a label is not in
+  // the table or the store is full: corrupt data on the decoder.
+  template <class Coder, class Oracle, class LabelOracle>
+  bool split(Coder& coder, uint32_t v, uint32_t v2, int level, int balance, Oracle&& oracle,
+             LabelOracle&& labelOracle);
 
   const ConnectivityStatistics& statistics() const { return statistics_; }
+  // Information content of the labels coded so far (measuring coders).
+  double labelBits() const { return labelBits_; }
 
  private:
   using Entry = StarEntry;
@@ -285,6 +298,8 @@ class VertexSplitter {
   double halfWidth_ = 0;  // of the split cell along the split axis (0: not geometric)
   // Orientation models: [dimension - 2][copy or new][vote class][face of higher].
   BitModel orientationModels_[2][2][3][2];
+  std::optional<LabelCoder> labels_;
+  double labelBits_ = 0;
   ConnectivityStatistics statistics_;
 };
 
@@ -320,8 +335,9 @@ void VertexSplitter::decideOrientation(Coder& coder, int dimension, uint32_t sim
   statistics_.orientationMispredicted += mispredicted;
 }
 
-template <class Coder, class Oracle>
-bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int balance, Oracle&& oracle) {
+template <class Coder, class Oracle, class LabelOracle>
+bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int balance, Oracle&& oracle,
+                           LabelOracle&& labelOracle) {
   newVertex_ = v2;
   gatherStar(store_, v, star_, begin_);
   linkFans();
@@ -429,7 +445,8 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int
   for (int d = 1; d <= SimplexStore::kMaxDimension; ++d) store_.detach(d, v);
   if (star_[0].code == 4) {
     const uint32_t edge[2] = {v, v2};
-    if (store_.add(1, edge, 0) == kNoSimplex) return false;
+    star_[0].added = store_.add(1, edge, 0);
+    if (star_[0].added == kNoSimplex) return false;
   }
   for (size_t i = 1; i < star_.size(); ++i) {
     Entry& entry = star_[i];
@@ -462,6 +479,42 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int
     if (entry.added != kNoSimplex && d + 1 >= 2)
       decideOrientation(coder, d + 1, entry.added, false,
                         uint8_t((entry.record >> split_record::kNewTargetShift) & 3));
+  }
+  if (labels_) {
+    const double before = coder.cost();
+    // Per dimension, whether the star's simplices had more than one label
+    // (a split inside a region makes simplices of its label), and the
+    // first two labels (a new simplex that does not take its parent's
+    // likely takes the other).
+    std::array<bool, 4> mixed{};
+    std::array<std::array<uint32_t, 2>, 4> seen;
+    for (int d = 1; d <= 3; ++d) {
+      seen[size_t(d)] = {kNoLabel, kNoLabel};
+      if (begin_[size_t(d)] == begin_[size_t(d) + 1]) continue;
+      seen[size_t(d)][0] = store_.label(d, star_[begin_[size_t(d)]].simplex);
+      for (size_t i = begin_[size_t(d)] + 1; i < begin_[size_t(d) + 1] && !mixed[size_t(d)]; ++i) {
+        const uint32_t label = store_.label(d, star_[i].simplex);
+        mixed[size_t(d)] = label != seen[size_t(d)][0];
+        seen[size_t(d)][1] = label;
+      }
+    }
+    for (const Entry& entry : star_) {
+      const int d = entry.dimension;
+      // The new edge v v2 has no parent: it takes the star's first edge's place.
+      const uint32_t parent = d == 0 ? seen[1][0] : store_.label(d, entry.simplex);
+      for (const bool isCopy : {true, false}) {
+        const uint32_t simplex = isCopy ? entry.copy : entry.added;
+        if (simplex == kNoSimplex) continue;
+        const int dimension = isCopy ? d : d + 1;
+        const std::array<uint32_t, 2>& both = seen[size_t(dimension)];
+        const uint32_t other = both[0] != parent ? both[0] : mixed[size_t(dimension)] ? both[1] : kNoLabel;
+        const uint32_t label =
+            labels_->code(coder, dimension, isCopy, mixed[size_t(dimension)], parent, other, labelOracle());
+        if (label == kNoLabel) return false;
+        store_.label(dimension, simplex) = label;
+      }
+    }
+    labelBits_ += coder.cost() - before;
   }
   return true;
 }

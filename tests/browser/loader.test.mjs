@@ -1,12 +1,12 @@
 // KDMeshLoader in headless chromium, as a three.js application uses it:
 // LoadingManager events and URL handling, abort(), dispose() mid-load, the
 // worker pool's limit, the BufferGeometry result, decoder limits, a
-// WebAssembly file that cannot be fetched, and vertex attributes. Models come from the viewer's
+// WebAssembly file that cannot be fetched, vertex attributes and simplex labels. Models come from the viewer's
 // dev server, paced where a load must still be running.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
 import { execFileSync } from 'node:child_process';
-import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
+import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
 import { launchChromium } from './chromium.mjs';
@@ -386,6 +386,32 @@ test('vertex attributes: color, the stream\'s normals, uv and others on the geom
     color: { type: 'Uint8Array', itemSize: 3, normalized: true, capacity: 3 * n },
   });
   assert.deepEqual(result.pageMaterial, { same: true, vertexColors: false });
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('simplex labels reach stats.model as the decoder gives them', async () => {
+  // A strip of quads, two triangles each, labelled 5 on the left half and -2 on the right.
+  const columns = 40, lines = [];
+  for (let i = 0; i <= columns; ++i) lines.push(`${i} 0 0`, `${i} 1 0.25`);
+  for (let i = 0; i < columns; ++i) {
+    const label = i < columns / 2 ? 5 : -2;
+    lines.push(`3 ${2 * i} ${2 * i + 2} ${2 * i + 3} ${label}`, `3 ${2 * i} ${2 * i + 3} ${2 * i + 1} ${label}`);
+  }
+  const header = ['ply', 'format ascii 1.0', `element vertex ${2 * (columns + 1)}`, 'property float x', 'property float y',
+    'property float z', `element face ${2 * columns}`, 'property list uchar int vertex_indices', 'property int label', 'end_header'];
+  writeFileSync(join(models, 'labelled.ply'), [...header, ...lines].join('\n') + '\n');
+  execFileSync(cli, ['encode', join(models, 'labelled.ply'), '-o', join(models, 'labelled.kdm'), '--bits', '12', '-q']);
+  const decoded = await decode(readFileSync(join(models, 'labelled.kdm')));
+  const { page, errors } = await openPage();
+  const result = await page.evaluate(async () => {
+    const loader = new KDMeshLoader();
+    const group = await loader.loadAsync('models/labelled.kdm');
+    const { labels, triangles } = group.userData.stats.model;
+    loader.dispose();
+    return { triangles: Array.from(labels.triangles), count: triangles.length / 3 };
+  });
+  assert.deepEqual(result, { triangles: Array.from(decoded.labels.triangles), count: decoded.triangles.length / 3 });
   assert.deepEqual(errors, []);
   await page.close();
 });

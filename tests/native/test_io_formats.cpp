@@ -403,7 +403,11 @@ TEST(IoMedit, ReadsCommentsCrlfWrappedValuesQuadsAndSkippedSections) {
     EXPECT_TRUE(r.hasNote("split 1 polygon with")) << joined(r.notes);
     EXPECT_TRUE(r.hasNote("skipped 2 Corners")) << joined(r.notes);
     EXPECT_TRUE(r.hasNote("skipped 1 Hexahedra")) << joined(r.notes);
-    EXPECT_TRUE(r.hasNote("nonzero references of 4")) << joined(r.notes);
+    EXPECT_TRUE(r.hasNote("nonzero references of 2 vertices")) << joined(r.notes);
+    // Element references are the simplices' labels.
+    EXPECT_EQ(r.complex.labels.edges, (std::vector<int32_t>{0}));
+    EXPECT_EQ(r.complex.labels.triangles, (std::vector<int32_t>{3, 3, 0}));
+    EXPECT_EQ(r.complex.labels.tetrahedra, (std::vector<int32_t>{2}));
     EXPECT_TRUE(r.hasNote("double precision")) << joined(r.notes);
     EXPECT_TRUE(r.hasNote("follows End (from line 33)")) << joined(r.notes);
   }
@@ -524,7 +528,7 @@ TEST(IoTetgen, ReadsHandWrittenFilesNumberedFromZeroOrOne) {
             bitsOf(std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0.1f, 0.2f, 0.3f}));
   EXPECT_EQ(zero.complex.tetrahedra, (std::vector<uint32_t>{0, 1, 2, 3, 4, 3, 2, 1}));
   EXPECT_TRUE(zero.hasNote("2 attributes and the boundary marker")) << joined(zero.notes);
-  EXPECT_TRUE(zero.hasNote("1 region attributes")) << joined(zero.notes);
+  EXPECT_EQ(zero.complex.labels.tetrahedra, (std::vector<int32_t>{-1, -1}));  // the region attribute
 
   // Numbered from 1, header without attribute counts, 10-node tetrahedra.
   writeWhole(dir / "one.node", "4 3\n1 0 0 0\n2 1 0 0\n3 0 1 0\n4 0 0 1\n");

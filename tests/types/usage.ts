@@ -18,6 +18,7 @@ export async function decoding(bytes: Uint8Array): Promise<number> {
   const parents: Uint32Array = decoder.parents();
   const colour: VertexAttribute | undefined = coarse.attributes.color;
   const attributeValues = (colour?.array.length ?? 0) + (colour?.itemSize ?? 0) + (header?.attributeCount ?? 0);
+  const regions: Int32Array | undefined = header?.labelled ? coarse.labels?.triangles : undefined;
   decoder.finish();
   decoder.dispose();
   try {
@@ -26,7 +27,7 @@ export async function decoding(bytes: Uint8Array): Promise<number> {
     if (error instanceof KdmeshError) return error.code.length;
   }
   return model.positions.length + progress.errorBound + (header?.simplexCounts[2] ?? 0) + coarse.triangles.length +
-    parents.length + attributeValues + (await memoryInUse()) + (model.stats.bitsPerVertex > 0 ? 1 : 0);
+    parents.length + attributeValues + (regions?.length ?? 0) + (await memoryInUse()) + (model.stats.bitsPerVertex > 0 ? 1 : 0);
 }
 
 export async function loading(renderer: WebGLRenderer): Promise<BufferGeometry> {

@@ -54,6 +54,33 @@ struct VertexAttribute {
 constexpr size_t kMaxAttributes = 15;
 constexpr size_t kMaxAttributeNameBytes = 64;
 
+// An integer label per listed edge, triangle and tetrahedron (a material,
+// region or group id), parallel to the simplex lists: labels.triangles[i]
+// belongs to triangle i. Each vector is empty (no labels) or holds one label
+// per simplex of its list. When any list has labels, a list with simplices
+// and no labels gets label 0 for each of them. Isolated points carry no
+// label: give them a vertex attribute instead.
+//
+// The codec keeps labels exactly: the decoded complex lists every input
+// maximal simplex with its label (in its own vertex ids and order). Labels
+// of input simplices the encoder drops (InputRepairs: duplicates, faces of
+// other listed simplices) are dropped with them. Every prefix gives each
+// simplex it lists the label of an input simplex it stands for.
+struct SimplexLabels {
+  std::vector<int32_t> edges;
+  std::vector<int32_t> triangles;
+  std::vector<int32_t> tetrahedra;
+
+  bool empty() const { return edges.empty() && triangles.empty() && tetrahedra.empty(); }
+  // The vector of dimension 1..3.
+  std::vector<int32_t>& of(int dimension) {
+    return dimension == 1 ? edges : dimension == 2 ? triangles : tetrahedra;
+  }
+  const std::vector<int32_t>& of(int dimension) const {
+    return dimension == 1 ? edges : dimension == 2 ? triangles : tetrahedra;
+  }
+};
+
 struct Complex {
   std::vector<float> positions;  // xyz, 3 floats per vertex
   std::vector<uint32_t> points;
@@ -61,6 +88,7 @@ struct Complex {
   std::vector<uint32_t> triangles;
   std::vector<uint32_t> tetrahedra;
   std::vector<VertexAttribute> attributes;
+  SimplexLabels labels;
 
   size_t vertexCount() const { return positions.size() / 3; }
   size_t simplexCount(int dimension) const;
@@ -131,6 +159,9 @@ struct Header {
   // Vertex attributes (up to kMaxAttributes): their names, types and the
   // root vertex's values are in the attribute table that starts the body.
   uint8_t attributeCount = 0;
+  // Whether edges, triangles and tetrahedra carry labels; the label table
+  // (the distinct labels) follows the attribute table.
+  bool labelled = false;
 
   // Bits of integer coordinate per axis: the kd-tree refines axis a
   // axisBits(a) times.
@@ -186,7 +217,7 @@ struct LevelCost {
   int axis = 0;
   uint32_t cells = 0;  // cells the level split: the model's vertices before it
   double geometryBits = 0;
-  double connectivityBits = 0;
+  double connectivityBits = 0;  // simplex labels included
 };
 
 // Information content of what a stream codes, in bits: the sum of -log2(p)
@@ -195,6 +226,7 @@ struct CodingCost {
   double geometryBits = 0;
   double connectivityBits = 0;
   std::vector<double> attributeBits;  // per vertex attribute, in the stream's order
+  double labelBits = 0;               // simplex labels (not in connectivityBits)
   // The same by kd-tree level, coarse to fine: where the bits of a model go,
   // and so how many a coarser quantization or a prefix of the stream would
   // keep. The decoder lists the levels it has completed.

@@ -334,6 +334,15 @@ Status checkAttributesWritable(Format format, const Complex& complex) {
                                                        "): write PLY to keep them");
 }
 
+// Simplex labels go to PLY (a `label` property), Medit (element references)
+// and TetGen (the region attribute); other formats refuse them.
+Status checkLabelsWritable(Format format, const Complex& complex) {
+  if (format == Format::Ply || format == Format::Medit || format == Format::TetGen || complex.labels.empty())
+    return Status::success();
+  return Status::error(ErrorCode::InvalidArgument, std::string(formatName(format)) +
+                                                       " cannot hold simplex labels: write PLY or Medit to keep them");
+}
+
 Status writeMemory(Format format, const Complex& complex,
                    std::vector<uint8_t>& out, const WriteOptions& options) {
   out.clear();
@@ -346,6 +355,7 @@ Status writeMemory(Format format, const Complex& complex,
   }
   if (Status status = checkWritable(complex); !status.ok()) return status;
   if (Status status = checkAttributesWritable(format, complex); !status.ok()) return status;
+  if (Status status = checkLabelsWritable(format, complex); !status.ok()) return status;
   Status status;
   switch (format) {
     case Format::Ply: status = detail::writePly(complex, out, options); break;

@@ -9,11 +9,18 @@
 //   Tetrahedra n  then "a b c d ref"
 //   End
 //
+// The references of edges, triangles and tetrahedra are their simplices'
+// labels (when any is nonzero); a triangle or edge that is a face of a
+// listed tetrahedron or triangle is no maximal simplex, and its reference is
+// dropped with it (noted). Vertex references are not kept.
+//
 // Values are read as a token stream, so counts and items may wrap over lines;
 // '#' starts a comment. Quadrilaterals become two triangles each (noted).
 // Sections whose item size is known but which hold no simplices (hexahedra,
 // prisms, corners, normals, ...) are skipped with a note; any other keyword
 // is an error, since there is no telling how much of the file it takes.
+#include <algorithm>
+#include <array>
 #include <limits>
 
 #include "io/io_internal.h"
@@ -132,8 +139,9 @@ class MeditReader {
           "rounded to float32");
     }
     split_.addNote(notes);
+    keepLabels(notes);
     addCountNote(notes, "ignored the nonzero references of ", labelled_,
-                 " vertices and elements");
+                 " vertices");
     for (const std::string& skipped : skipped_) notes.push_back(skipped);
     return Status::success();
   }
@@ -230,9 +238,11 @@ class MeditReader {
                        " is not a number");
         }
       }
-      if (Status status = readReference(Kind::Vertices, v); !status.ok()) {
+      int64_t reference = 0;
+      if (Status status = readReference(Kind::Vertices, v, reference); !status.ok()) {
         return status;
       }
+      labelled_ += reference != 0;
       out_.positions.insert(out_.positions.end(), xyz, xyz + 3);
     }
     return Status::success();
@@ -272,14 +282,23 @@ class MeditReader {
         }
         corners[k] = static_cast<uint32_t>(value - 1);
       }
-      if (Status status = readReference(kind, item); !status.ok()) {
+      int64_t reference = 0;
+      if (Status status = readReference(kind, item, reference); !status.ok()) {
         return status;
+      }
+      if (reference < std::numeric_limits<int32_t>::min() || reference > std::numeric_limits<int32_t>::max()) {
+        return error(std::string(itemName(kind)) + " " + std::to_string(item) + ": reference " +
+                     std::to_string(reference) + " does not fit 32 bits");
       }
       if (kind == Kind::Quadrilaterals) {
         split_.append(corners, 4, target);
       } else {
         target.insert(target.end(), corners, corners + size);
       }
+      // A quadrilateral's triangles all take its reference.
+      const int d = kind == Kind::Edges ? 1 : kind == Kind::Tetrahedra ? 3 : 2;
+      references_.of(d).resize(target.size() / size_t(d + 1), int32_t(reference));
+      nonzeroReferences_ |= reference != 0;
     }
     return Status::success();
   }
@@ -310,18 +329,62 @@ class MeditReader {
     return Status::success();
   }
 
-  Status readReference(Kind kind, uint64_t item) {
+  Status readReference(Kind kind, uint64_t item, int64_t& reference) {
     std::string_view token;
     if (Status status = nextValue(kind, item, token); !status.ok()) {
       return status;
     }
-    int64_t reference = 0;
     if (!parseInteger(token, reference)) {
       return error(std::string(itemName(kind)) + " " + std::to_string(item) +
                    ": reference " + quoted(token) + " is not an integer");
     }
-    labelled_ += reference != 0;
     return Status::success();
+  }
+
+  // Sorts the first n (2 or 3) ids.
+  static void sortFirst(std::array<uint32_t, 3>& ids, size_t n) {
+    if (ids[0] > ids[1]) std::swap(ids[0], ids[1]);
+    if (n < 3) return;
+    if (ids[1] > ids[2]) std::swap(ids[1], ids[2]);
+    if (ids[0] > ids[1]) std::swap(ids[0], ids[1]);
+  }
+
+  // Element references become labels when any is nonzero (all zero say
+  // nothing). Those of edges and triangles that are faces of listed
+  // triangles or tetrahedra are counted in a note: the encoder drops such
+  // faces.
+  void keepLabels(Notes& notes) {
+    if (!nonzeroReferences_) return;
+    out_.labels = std::move(references_);
+    uint64_t dropped = 0;
+    std::vector<std::array<uint32_t, 3>> faces;  // sorted vertex ids, 0-padded
+    for (int d = 2; d >= 1; --d) {
+      const std::vector<uint32_t>& higher = d == 2 ? out_.tetrahedra : out_.triangles;
+      const size_t arity = size_t(d + 2);
+      faces.clear();
+      for (size_t i = 0; i < higher.size(); i += arity)
+        for (size_t skip = 0; skip < arity; ++skip) {
+          std::array<uint32_t, 3> face{0, 0, 0};
+          size_t n = 0;
+          for (size_t k = 0; k < arity; ++k)
+            if (k != skip) face[n++] = higher[i + k];
+          sortFirst(face, n);
+          faces.push_back(face);
+        }
+      std::sort(faces.begin(), faces.end());
+      const std::vector<uint32_t>& list = d == 2 ? out_.triangles : out_.edges;
+      const std::vector<int32_t>& labels = out_.labels.of(d);
+      for (size_t i = 0; i < labels.size(); ++i) {
+        if (labels[i] == 0) continue;
+        std::array<uint32_t, 3> simplex{0, 0, 0};
+        std::copy(list.begin() + std::ptrdiff_t(i * size_t(d + 1)), list.begin() + std::ptrdiff_t((i + 1) * size_t(d + 1)),
+                  simplex.begin());
+        sortFirst(simplex, size_t(d + 1));
+        dropped += std::binary_search(faces.begin(), faces.end(), simplex);
+      }
+    }
+    addCountNote(notes, "dropped the nonzero references of ", dropped,
+                 " edges and triangles that are faces of listed triangles or tetrahedra");
   }
 
   TextScanner scanner_;
@@ -329,7 +392,9 @@ class MeditReader {
   bool sawVersion_ = false;
   bool sawVertices_ = false;
   bool doublePrecision_ = false;
-  size_t labelled_ = 0;
+  size_t labelled_ = 0;  // vertices with a nonzero reference
+  SimplexLabels references_;  // of the elements, one per simplex
+  bool nonzeroReferences_ = false;
   PolygonSplit split_;
   std::vector<std::string> skipped_;
 };
@@ -361,9 +426,10 @@ Status writeMedit(const Complex& complex, std::vector<uint8_t>& out) {
     const char* keyword;
     const std::vector<uint32_t>& indices;
     size_t arity;
-  } sections[] = {{"Edges", complex.edges, 2},
-                  {"Triangles", complex.triangles, 3},
-                  {"Tetrahedra", complex.tetrahedra, 4}};
+    const std::vector<int32_t>& labels;  // the references, if any
+  } sections[] = {{"Edges", complex.edges, 2, complex.labels.edges},
+                  {"Triangles", complex.triangles, 3, complex.labels.triangles},
+                  {"Tetrahedra", complex.tetrahedra, 4, complex.labels.tetrahedra}};
   for (const auto& section : sections) {
     if (section.indices.empty()) continue;
     text.word(section.keyword).endLine();
@@ -372,7 +438,9 @@ Status writeMedit(const Complex& complex, std::vector<uint8_t>& out) {
       for (size_t k = 0; k < section.arity; ++k) {
         text.integer(uint64_t{section.indices[i + k]} + 1);  // 1-based
       }
-      text.integer(0).endLine();
+      if (section.labels.empty()) text.integer(0);
+      else text.word(std::to_string(section.labels[i / section.arity]));
+      text.endLine();
     }
   }
   text.word("End").endLine();

@@ -240,7 +240,11 @@ Status parseHeader(TextScanner& scanner, PlyHeader& header) {
 // ---------------------------------------------------------------------------
 
 enum class Role : uint8_t { Vertex, Face, Edge, Tetra, Other };
-enum class Use : uint8_t { Skip, X, Y, Z, First, Second, List, Attribute };
+enum class Use : uint8_t { Skip, X, Y, Z, First, Second, List, Attribute, Label };
+
+// Integer properties of faces, edges and tetrahedra read as their simplices'
+// labels (the first of these an element has); the writer names them `label`.
+constexpr std::string_view kLabelNames[] = {"label", "material_index", "region"};
 
 bool isIndexUse(Use use) {
   return use == Use::First || use == Use::Second || use == Use::List;
@@ -301,6 +305,7 @@ struct ElementPlan {
   // exactly four vertices.
   uint64_t listMin = 0;
   uint64_t listMax = 0;
+  bool labelled = false;  // a property is the simplices' label (Use::Label)
 };
 
 // The PLY scalar types an attribute keeps bit for bit.
@@ -432,6 +437,18 @@ Status planElement(const PlyElement& element, ElementPlan& plan,
   plan.slots.resize(plan.uses.size());
   if (plan.role == Role::Vertex) {
     planAttributes(element, plan, skipped);
+  } else if (plan.role != Role::Other) {
+    for (const std::string_view name : kLabelNames) {
+      for (size_t i = 0; i < plan.uses.size() && !plan.labelled; ++i) {
+        const PlyProperty& property = element.properties[i];
+        if (plan.uses[i] == Use::Skip && !property.isList && isInteger(property.type) && property.name == name) {
+          plan.uses[i] = Use::Label;
+          plan.labelled = true;
+        }
+      }
+    }
+    for (size_t i = 0; i < plan.uses.size(); ++i)
+      if (plan.uses[i] == Use::Skip) skipped += " " + element.properties[i].name;
   } else {
     for (size_t i = 0; i < plan.uses.size(); ++i)
       if (plan.uses[i] == Use::Skip) skipped += " " + element.properties[i].name;
@@ -691,9 +708,19 @@ Status readElement(Values& values, const PlyElement& element,
   Complex& out = state.out;
   // One vertex's attribute values, component by component.
   std::vector<std::array<uint8_t, 16>> vertexValues(plan.attributes.size());
+  // The simplex list the element adds to, and its labels.
+  const int dimension = plan.role == Role::Edge ? 1 : plan.role == Role::Face ? 2 : plan.role == Role::Tetra ? 3 : 0;
+  const std::vector<uint32_t>* simplices =
+      dimension == 1 ? &out.edges : dimension == 2 ? &out.triangles : dimension == 3 ? &out.tetrahedra : nullptr;
+  if (plan.labelled) {
+    // Simplices listed before this element (a second face element) get 0.
+    std::vector<int32_t>& labels = out.labels.of(dimension);
+    labels.resize(simplices->size() / size_t(dimension + 1), 0);
+  }
   for (uint64_t item = 0; item < element.count; ++item) {
     float xyz[3] = {0, 0, 0};
     uint32_t pair[2] = {0, 0};
+    int64_t label = 0;
     for (size_t i = 0; i < element.properties.size(); ++i) {
       const PlyProperty& property = element.properties[i];
       const Use use = plan.uses[i];
@@ -717,6 +744,13 @@ Status readElement(Values& values, const PlyElement& element,
                                 vertexValues[slot.index].data() + slot.component * scalarBytes(property.type));
           break;
         }
+        case Use::Label:
+          ok = values.integer(property.type, label);
+          if (ok && (label < std::numeric_limits<int32_t>::min() || label > std::numeric_limits<int32_t>::max())) {
+            return inputError(element.name + " " + std::to_string(item) + " (" + values.place() + "): label " +
+                              std::to_string(label) + " does not fit 32 bits");
+          }
+          break;
         case Use::Skip:
           ok = skipProperty(values, property);
           break;
@@ -747,6 +781,11 @@ Status readElement(Values& values, const PlyElement& element,
         break;
       case Role::Other:
         break;
+    }
+    if (plan.labelled) {
+      // A polygon's triangles all take its label.
+      std::vector<int32_t>& labels = out.labels.of(dimension);
+      labels.resize(simplices->size() / size_t(dimension + 1), int32_t(label));
     }
   }
   return Status::success();
@@ -875,6 +914,9 @@ Status readPly(Input& input, Complex& out, Notes& notes) {
           ? readAsciiBody(input, header, plans, state, trailingValues)
           : readBinaryBody(input, body, header, plans, state, trailingBytes);
   if (!status.ok()) return status;
+  // Simplices of an element without labels, listed after one with: label 0.
+  for (int d = 1; d <= 3; ++d)
+    if (!out.labels.of(d).empty()) out.labels.of(d).resize(out.simplexCount(d), 0);
   state.split.addNote(notes);
   addCountNote(notes, "ignored ", trailingBytes,
                " bytes after the last PLY element");
@@ -896,6 +938,7 @@ struct SimplexElement {
   const std::vector<uint32_t>& indices;
   uint8_t arity;
   bool isList;
+  const std::vector<int32_t>& labels;  // empty, or one per simplex
 };
 
 // The PLY names of an attribute's components: the names the reader groups
@@ -939,6 +982,7 @@ class BinarySink {
   }
   void listLength(uint8_t length) { out_.push_back(length); }
   void index(uint32_t value) { appendLittleEndian(out_, value); }
+  void label(int32_t value) { appendLittleEndian(out_, value); }
   void endItem() {}
 
  private:
@@ -967,6 +1011,7 @@ class TextSink {
   }
   void listLength(uint8_t length) { text_.integer(length); }
   void index(uint32_t value) { text_.integer(value); }
+  void label(int32_t value) { text_.word(std::to_string(value)); }
   void endItem() { text_.endLine(); }
 
  private:
@@ -992,6 +1037,7 @@ void writeBody(const Complex& complex,
       for (size_t k = 0; k < element.arity; ++k) {
         sink.index(element.indices[i + k]);
       }
+      if (!element.labels.empty()) sink.label(element.labels[i / element.arity]);
       sink.endItem();
     }
   }
@@ -1024,6 +1070,7 @@ void writeHeader(const Complex& complex,
       text.word("property int vertex1").endLine();
       text.word("property int vertex2").endLine();
     }
+    if (!element.labels.empty()) text.word("property int label").endLine();
   }
   text.word("end_header").endLine();
 }
@@ -1039,13 +1086,13 @@ Status writePly(const Complex& complex, std::vector<uint8_t>& out,
   }
   std::vector<SimplexElement> elements;
   if (!complex.triangles.empty()) {
-    elements.push_back({"face", complex.triangles, 3, true});
+    elements.push_back({"face", complex.triangles, 3, true, complex.labels.triangles});
   }
   if (!complex.edges.empty()) {
-    elements.push_back({"edge", complex.edges, 2, false});
+    elements.push_back({"edge", complex.edges, 2, false, complex.labels.edges});
   }
   if (!complex.tetrahedra.empty()) {
-    elements.push_back({"tetra", complex.tetrahedra, 4, true});
+    elements.push_back({"tetra", complex.tetrahedra, 4, true, complex.labels.tetrahedra});
   }
   writeHeader(complex, elements, options.asciiPly, out);
   if (options.asciiPly) {
@@ -1054,7 +1101,8 @@ Status writePly(const Complex& complex, std::vector<uint8_t>& out,
   } else {
     out.reserve(out.size() + 4 * complex.positions.size() +
                 complex.triangles.size() / 3 * 13 + 4 * complex.edges.size() +
-                complex.tetrahedra.size() / 4 * 17);
+                complex.tetrahedra.size() / 4 * 17 + 4 * (complex.labels.edges.size() +
+                complex.labels.triangles.size() + complex.labels.tetrahedra.size()));
     BinarySink sink(out);
     writeBody(complex, elements, sink);
   }

@@ -9,6 +9,7 @@
 // the .ele file uses the same numbering. A 10-node tetrahedron lists its 4
 // corners first; the other 6 nodes are mid-edge points and stay vertices
 // without simplices. Node order is kept as is, so the orientation survives.
+#include <cmath>
 #include <limits>
 
 #include "io/io_internal.h"
@@ -260,8 +261,27 @@ Status readTetgenEle(const uint8_t* data, size_t size, uint32_t firstIndex,
       }
       if (k < 4) corners[k] = static_cast<uint32_t>(index);
     }
-    if (Status status =
-            skipColumns(scanner, "tetrahedron", t, attributes, extraLines);
+    // The first region attribute is the tetrahedron's label (TetGen writes
+    // the integer region numbers of -A as reals).
+    if (attributes > 0) {
+      std::string_view token;
+      int64_t region = 0;
+      float real = 0;
+      const bool read = scanner.nextToken(token);
+      if (read && !parseInteger(token, region) && parseFloat(token, real) && real == std::floor(real) &&
+          std::fabs(real) <= 16777216.f) {
+        region = int64_t(real);  // an integer that float32 holds exactly
+      } else if (read && !parseInteger(token, region)) {
+        region = int64_t(1) << 40;  // refused below
+      }
+      if (read && region >= std::numeric_limits<int32_t>::min() && region <= std::numeric_limits<int32_t>::max()) {
+        out.labels.tetrahedra.push_back(int32_t(region));
+      } else {
+        return lineError(scanner.lineNumber(), "tetrahedron " + std::to_string(t) + ": region attribute " +
+                                                   quoted(token) + " is not an integer");
+      }
+    }
+    if (Status status = skipColumns(scanner, "tetrahedron", t, attributes > 0 ? attributes - 1 : 0, extraLines);
         !status.ok()) {
       return status;
     }
@@ -273,9 +293,9 @@ Status readTetgenEle(const uint8_t* data, size_t size, uint32_t firstIndex,
                     " 10-node tetrahedra; their mid-edge nodes are vertices "
                     "without simplices");
   }
-  if (attributes > 0) {
-    notes.push_back("ignored the " + std::to_string(attributes) +
-                    " region attributes of every tetrahedron");
+  if (attributes > 1) {
+    notes.push_back("kept the first region attribute of every tetrahedron as its label, ignored the other " +
+                    std::to_string(attributes - 1));
   }
   addCountNote(notes, "ignored extra values on ", extraLines,
                " .ele tetrahedron lines");
@@ -314,12 +334,14 @@ Status writeTetgenEle(const Complex& complex, std::vector<uint8_t>& out) {
   TextOut text(out);
   text.word("# written by kdmesh").endLine();
   const std::vector<uint32_t>& tetrahedra = complex.tetrahedra;
-  text.integer(tetrahedra.size() / 4).integer(4).integer(0).endLine();
+  const std::vector<int32_t>& labels = complex.labels.tetrahedra;  // as the region attribute
+  text.integer(tetrahedra.size() / 4).integer(4).integer(labels.empty() ? 0 : 1).endLine();
   for (size_t i = 0; i < tetrahedra.size(); i += 4) {
     text.integer(i / 4 + 1);
     for (size_t k = 0; k < 4; ++k) {
       text.integer(uint64_t{tetrahedra[i + k]} + 1);
     }
+    if (!labels.empty()) text.word(std::to_string(labels[i / 4]));
     text.endLine();
   }
   return Status::success();
