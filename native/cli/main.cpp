@@ -17,6 +17,7 @@
 
 #include <unistd.h>
 
+#include "kdmesh/gltf.h"
 #include "kdmesh/io.h"
 #include "kdmesh/kdmesh.h"
 
@@ -148,9 +149,45 @@ struct EncodeArgs {
   size_t chunkBytes = 16 * 1024;
   bool pointsOnly = false;
   bool weld = false;
+  bool bitsGiven = false;  // --bits on the command line: glTF positions go to the grid
+  bool fallback = false;
+  bool kdmFiles = false;
 };
 
+void reportGltf(const std::string& output, const kdmesh::gltf::Summary& summary, const char* verb, double seconds) {
+  if (gQuiet) return;
+  std::fprintf(stderr, "%s: %s of %zu primitives, %s, %" PRIu64 " stream bytes [%s %.3fs]\n", output.c_str(),
+               counted(summary.streams, "stream", "streams").c_str(), summary.primitives,
+               counted(size_t(summary.vertices), "vertex", "vertices").c_str(), summary.streamBytes, verb, seconds);
+}
+
+// A glTF scene: every primitive becomes a kdmesh stream (kdmesh/gltf.h),
+// positions bit for bit unless --bits is given.
+int runEncodeGltf(const EncodeArgs& args) {
+  const auto start = Clock::now();
+  kdmesh::gltf::EncodeOptions options;
+  options.stream.exact = args.exact || !args.bitsGiven;
+  options.stream.bits = args.bits;
+  options.stream.chunkBytes = args.chunkBytes;
+  options.fallback = args.fallback;
+  options.separateStreams = args.kdmFiles;
+  kdmesh::io::Notes notes;
+  kdmesh::gltf::Summary summary;
+  const kdmesh::Status s = kdmesh::gltf::encodeFile(args.input, args.output, options, notes, &summary);
+  for (const std::string& n : notes) note(args.input + ": " + n);
+  if (!s.ok()) return fail(s, "cannot encode " + args.input);
+  reportGltf(args.output, summary, "encode", secondsSince(start));
+  return 0;
+}
+
 int runEncode(const EncodeArgs& args) {
+  if (kdmesh::gltf::isGltfPath(args.input) || kdmesh::gltf::isGltfPath(args.output)) {
+    if (!kdmesh::gltf::isGltfPath(args.input) || !kdmesh::gltf::isGltfPath(args.output))
+      return fail("a glTF scene encodes to a glTF scene: give .glb or .gltf for both input and output");
+    if (args.pointsOnly || args.weld) return fail("--points-only and --weld do not apply to glTF scenes");
+    return runEncodeGltf(args);
+  }
+  if (args.fallback || args.kdmFiles) return fail("--fallback and --kdm-files apply to glTF scenes only");
   const auto start = Clock::now();
   kdmesh::Complex complex;
   kdmesh::io::Notes notes;
@@ -239,7 +276,21 @@ std::string keepWhatTheFormatHolds(kdmesh::io::Format format, kdmesh::Complex& c
   return dropped;
 }
 
+int runDecodeGltf(const DecodeArgs& args) {
+  if (!kdmesh::gltf::isGltfPath(args.output)) return fail("a glTF scene decodes to a glTF scene: give a .glb or .gltf output");
+  if (args.bytes > 0) return fail("--bytes applies to .kdm streams only");
+  const auto start = Clock::now();
+  kdmesh::io::Notes notes;
+  kdmesh::gltf::Summary summary;
+  const kdmesh::Status s = kdmesh::gltf::decodeFile(args.input, args.output, notes, &summary);
+  for (const std::string& n : notes) note(args.input + ": " + n);
+  if (!s.ok()) return fail(s, "cannot decode " + args.input);
+  reportGltf(args.output, summary, "decode", secondsSince(start));
+  return 0;
+}
+
 int runDecode(const DecodeArgs& args) {
+  if (kdmesh::gltf::isGltfPath(args.input)) return runDecodeGltf(args);
   std::vector<uint8_t> bytes;
   std::string error;
   if (!readBytes(args.input, bytes, error)) return fail(error);
@@ -456,12 +507,12 @@ int main(int argc, char** argv) {
 
   EncodeArgs encodeArgs;
   CLI::App* encode = app.add_subcommand(
-      "encode", "Compress a PLY, OBJ, OFF, XYZ, STL, Medit, TetGen or VTK file to .kdm");
+      "encode", "Compress a PLY, OBJ, OFF, XYZ, STL, Medit, TetGen or VTK file to .kdm, or the geometry of a glTF scene");
   encode->add_option("input", encodeArgs.input,
-                     "Input file (.ply .obj .off .xyz .stl .mesh .node/.ele .vtk)")
+                     "Input file (.ply .obj .off .xyz .stl .mesh .node/.ele .vtk, or .glb .gltf)")
       ->required()
       ->check(CLI::ExistingFile);
-  encode->add_option("-o,--output", encodeArgs.output, "Output .kdm file")->required();
+  encode->add_option("-o,--output", encodeArgs.output, "Output .kdm file (.glb or .gltf for a glTF scene)")->required();
   auto* bits = encode->add_option("--bits", encodeArgs.bits,
                                   "Grid bits of the longest bounding-box axis (1-30)")
                    ->check(CLI::Range(1, 30))
@@ -475,12 +526,18 @@ int main(int argc, char** argv) {
                    "Drop edges, triangles and tetrahedra and encode the vertices");
   encode->add_flag("--weld", encodeArgs.weld,
                    "Merge vertices with bit-identical positions (for STL triangle soups)");
+  encode->add_flag("--fallback", encodeArgs.fallback,
+                   "glTF: keep the uncompressed accessors too, for loaders without the extension");
+  encode->add_flag("--kdm-files", encodeArgs.kdmFiles,
+                   "glTF: write each stream to a .kdm file next to the output, for pages to stream");
 
   DecodeArgs decodeArgs;
   CLI::App* decode = app.add_subcommand("decode", "Decompress a .kdm file (or a prefix of it)");
-  decode->add_option("input", decodeArgs.input, "Input .kdm file")->required()->check(CLI::ExistingFile);
+  decode->add_option("input", decodeArgs.input, "Input .kdm file, or a glTF scene with kdmesh streams")
+      ->required()
+      ->check(CLI::ExistingFile);
   decode->add_option("-o,--output", decodeArgs.output,
-                     "Output file (.ply .obj .off .xyz .mesh .node .vtk)")
+                     "Output file (.ply .obj .off .xyz .mesh .node .vtk; .glb .gltf for a scene)")
       ->required();
   decode->add_option("--bytes", decodeArgs.bytes,
                      "Decode only the first N bytes: the model as a viewer sees it after N bytes");
@@ -505,6 +562,7 @@ int main(int argc, char** argv) {
     return e.get_exit_code();
   }
   try {
+    encodeArgs.bitsGiven = bits->count() > 0;
     if (encode->parsed()) return runEncode(encodeArgs);
     if (decode->parsed()) return runDecode(decodeArgs);
     return runInfo(infoInput, infoJson, infoLevels);
