@@ -310,7 +310,7 @@ int runDecode(const DecodeArgs& args) {
     const std::string dropped = keepWhatTheFormatHolds(outputFormat, complex);
     if (!dropped.empty()) note(args.output + ": left out " + dropped + " of the prefix, which " + formatName + " cannot hold");
   }
-  // Only PLY holds vertex attributes.
+  // Only PLY and glTF hold vertex attributes.
   if (outputFormat != kdmesh::io::Format::Ply && outputFormat != kdmesh::io::Format::Unknown &&
       !complex.attributes.empty()) {
     std::string names;
@@ -318,8 +318,14 @@ int runDecode(const DecodeArgs& args) {
     note(args.output + ": left out the vertex attributes " + names + ", which " + formatName + " cannot hold");
     complex.attributes.clear();
   }
-  if (auto s = kdmesh::io::writeFile(args.output, complex, writeOptions); !s.ok())
+  if (kdmesh::gltf::isGltfPath(args.output)) {
+    kdmesh::io::Notes notes;
+    const kdmesh::Status s = kdmesh::gltf::writeComplexScene(args.output, complex, notes);
+    for (const std::string& n : notes) note(args.output + ": " + n);
+    if (!s.ok()) return fail(s, args.output);
+  } else if (auto s = kdmesh::io::writeFile(args.output, complex, writeOptions); !s.ok()) {
     return fail(s, args.output);
+  }
   if (!gQuiet)
     std::fprintf(stderr, "%s: %zu vertices from %zu bytes%s [decode %.3fs]\n", args.output.c_str(),
                  complex.vertexCount(), bytes.size(), prefix ? " (prefix)" : "", seconds);
@@ -537,7 +543,7 @@ int main(int argc, char** argv) {
       ->required()
       ->check(CLI::ExistingFile);
   decode->add_option("-o,--output", decodeArgs.output,
-                     "Output file (.ply .obj .off .xyz .mesh .node .vtk; .glb .gltf for a scene)")
+                     "Output file (.ply .obj .off .xyz .mesh .node .vtk .glb .gltf)")
       ->required();
   decode->add_option("--bytes", decodeArgs.bytes,
                      "Decode only the first N bytes: the model as a viewer sees it after N bytes");

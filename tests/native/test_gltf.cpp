@@ -634,3 +634,58 @@ TEST_F(GltfTest, CompressedInputIsRefused) {
 
 }  // namespace
 }  // namespace kdmesh::test
+
+namespace kdmesh::test {
+namespace {
+
+TEST_F(GltfTest, AComplexBecomesASceneOfOneMeshWithItsAttributes) {
+  Complex c;
+  c.positions = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0, 5, 5, 5, 6, 6, 6};
+  c.triangles = {0, 1, 2, 1, 3, 2};
+  c.edges = {3, 4};
+  // Vertex 5 is an isolated point.
+  const auto attribute = [&](const char* name, AttributeType type, uint8_t components) {
+    VertexAttribute a;
+    a.name = name;
+    a.type = type;
+    a.components = components;
+    a.values.resize(c.vertexCount() * a.valueBytes());
+    for (size_t i = 0; i < a.values.size(); ++i) a.values[i] = uint8_t(i * 37 + 11);
+    if (type == AttributeType::Float32)
+      for (size_t i = 0; i < a.values.size(); i += 4) {
+        const float f = float(i) / 7.0f;
+        std::memcpy(&a.values[i], &f, 4);
+      }
+    c.attributes.push_back(a);
+  };
+  attribute("color", AttributeType::UInt8, 3);
+  attribute("normal", AttributeType::Float32, 3);
+  attribute("uv", AttributeType::Float32, 2);
+  attribute("label", AttributeType::Int16, 1);
+  attribute("id", AttributeType::Int32, 1);
+  io::Notes notes;
+  ASSERT_TRUE(gltf::writeComplexScene(at("complex.glb"), c, notes).ok());
+  ASSERT_EQ(notes.size(), 1u);
+  EXPECT_NE(notes[0].find("id"), std::string::npos);
+  const Model scene = load("complex.glb");
+  ASSERT_EQ(scene.meshes.size(), 1u);
+  const auto& primitives = scene.meshes[0].primitives;
+  ASSERT_EQ(primitives.size(), 3u);
+  EXPECT_EQ(primitives[0].mode, TINYGLTF_MODE_TRIANGLES);
+  EXPECT_EQ(primitives[1].mode, TINYGLTF_MODE_LINE);
+  EXPECT_EQ(primitives[2].mode, TINYGLTF_MODE_POINTS);
+  const std::map<std::string, int> semantics = primitives[0].attributes;
+  for (const char* s : {"POSITION", "COLOR_0", "NORMAL", "TEXCOORD_0", "_LABEL"}) EXPECT_TRUE(semantics.count(s)) << s;
+  EXPECT_FALSE(semantics.count("_ID"));
+  EXPECT_TRUE(scene.accessors[size_t(semantics.at("COLOR_0"))].normalized);
+  EXPECT_EQ(Drawn(drawnBy(scene, primitives[2])).simplices.size(), 1u);
+  // Each primitive of the shared vertices round trips on its own vertices.
+  roundTrip("complex.glb", "complex.kdm.glb", "plain.glb");
+  const Model out = load("plain.glb");
+  for (size_t p = 0; p < 3; ++p) EXPECT_TRUE(drawnBy(scene, primitives[p]) == drawnBy(out, out.meshes[0].primitives[p])) << p;
+  c.tetrahedra = {0, 1, 2, 4};
+  EXPECT_EQ(gltf::writeComplexScene(at("tetrahedra.glb"), c, notes).code, ErrorCode::InvalidArgument);
+}
+
+}  // namespace
+}  // namespace kdmesh::test

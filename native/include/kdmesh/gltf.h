@@ -65,4 +65,13 @@ Status encodeFile(const std::string& input, const std::string& output, const Enc
 Status decodeFile(const std::string& input, const std::string& output, io::Notes& notes,
                   Summary* summary = nullptr);
 
+// Writes a complex as a scene of one mesh (.glb, or .gltf with its .bin):
+// a TRIANGLES, a LINES and a POINTS primitive (the vertices in no simplex)
+// sharing the vertex accessors. Vertex attributes become COLOR_0
+// ('color', normalized integers), NORMAL ('normal', float x 3), TEXCOORD_0
+// ('uv', float x 2) and "_NAME" for the others; 32-bit integer attributes,
+// which glTF vertex attributes cannot hold, are left out with a note.
+// Tetrahedra are an InvalidArgument error.
+Status writeComplexScene(const std::string& path, const Complex& complex, io::Notes& notes);
+
 }  // namespace kdmesh::gltf
