@@ -156,8 +156,9 @@ struct EncodeArgs {
 
 void reportGltf(const std::string& output, const kdmesh::gltf::Summary& summary, const char* verb, double seconds) {
   if (gQuiet) return;
-  std::fprintf(stderr, "%s: %s of %zu primitives, %s, %" PRIu64 " stream bytes [%s %.3fs]\n", output.c_str(),
-               counted(summary.streams, "stream", "streams").c_str(), summary.primitives,
+  std::fprintf(stderr, "%s: %s of %s, %s, %" PRIu64 " stream bytes [%s %.3fs]\n", output.c_str(),
+               counted(summary.streams, "stream", "streams").c_str(),
+               counted(summary.primitives, "primitive", "primitives").c_str(),
                counted(size_t(summary.vertices), "vertex", "vertices").c_str(), summary.streamBytes, verb, seconds);
 }
 
