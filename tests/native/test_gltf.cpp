@@ -623,6 +623,26 @@ TEST_F(GltfTest, DamagedStreamsAndFilesAreErrors) {
   }
 }
 
+TEST_F(GltfTest, DeeplyNestedAndMalformedJsonAreErrors) {
+  // Brackets nested 100,000 deep would take a recursive parser's stack.
+  std::string nested = "{\"asset\": {\"version\": \"2.0\"}, \"extras\": " + std::string(100000, '[') +
+                       std::string(100000, ']') + "}";
+  std::ofstream(at("nested.gltf")) << nested;
+  io::Notes notes;
+  Status s = gltf::encodeFile(at("nested.gltf"), at("out.glb"), {}, notes);
+  EXPECT_EQ(s.code, ErrorCode::InvalidInput);
+  EXPECT_NE(s.message.find("nests deeper"), std::string::npos) << s.message;
+  // Meshes of the wrong JSON types: an error from tinygltf, no exception.
+  for (const char* text : {"{\"asset\": {\"version\": \"2.0\"}, \"meshes\": [3, {\"primitives\": 7}], \"accessors\": []}",
+                           "{\"asset\": {\"version\": \"2.0\"}, \"meshes\": [{\"primitives\": [{\"indices\": 0, \"attributes\": {}}]}], "
+                           "\"accessors\": [5]}",
+                           "{\"asset\": ", "not json"}) {
+    std::ofstream(at("bad.gltf")) << text;
+    s = gltf::encodeFile(at("bad.gltf"), at("out.glb"), {}, notes);
+    EXPECT_FALSE(s.ok()) << text;
+  }
+}
+
 TEST_F(GltfTest, CompressedInputIsRefused) {
   save(testScene(), "scene.glb");
   io::Notes notes;

@@ -69,6 +69,32 @@ bool readWholeFile(const std::string& path, std::vector<uint8_t>& bytes, std::st
   return true;
 }
 
+// JSON arrays and objects nest at most this deep in a scene (glTF needs
+// about 10): the JSON parsers recurse once per level, and a file of deeply
+// nested brackets would exhaust the stack.
+constexpr int kMaxJsonDepth = 256;
+
+// Whether the brackets of JSON text (outside strings) nest at most
+// kMaxJsonDepth deep.
+bool nestingWithinLimit(const uint8_t* text, size_t size) {
+  int depth = 0;
+  bool inString = false;
+  for (size_t i = 0; i < size; ++i) {
+    const uint8_t c = text[i];
+    if (inString) {
+      if (c == '\\') ++i;
+      else if (c == '"') inString = false;
+    } else if (c == '"') {
+      inString = true;
+    } else if (c == '[' || c == '{') {
+      if (++depth > kMaxJsonDepth) return false;
+    } else if (c == ']' || c == '}') {
+      --depth;
+    }
+  }
+  return true;
+}
+
 // A primitive's indices taken out of the JSON (see holdDatalessIndices).
 struct HeldIndices {
   size_t mesh, primitive;
@@ -96,8 +122,9 @@ std::vector<HeldIndices> holdDatalessIndices(std::vector<uint8_t>& bytes, bool b
   if (!json.is_object() || !json["meshes"].is_array() || !json["accessors"].is_array()) return held;
   const nlohmann::json& accessors = json["accessors"];
   for (size_t m = 0; m < json["meshes"].size(); ++m) {
-    nlohmann::json& primitives = json["meshes"][m]["primitives"];
-    if (!primitives.is_array()) continue;
+    nlohmann::json& mesh = json["meshes"][m];
+    if (!mesh.is_object() || !mesh.contains("primitives") || !mesh["primitives"].is_array()) continue;
+    nlohmann::json& primitives = mesh["primitives"];
     for (size_t p = 0; p < primitives.size(); ++p) {
       nlohmann::json& primitive = primitives[p];
       if (!primitive.is_object() || !primitive.contains("indices") || !primitive["indices"].is_number_unsigned()) continue;
@@ -164,6 +191,14 @@ Status loadScene(const std::string& path, tinygltf::Model& model, io::Notes& not
   loader.SetImageLoader(keepEncodedImage, nullptr);
   std::string warnings;
   const bool binary = bytes.size() >= 4 && std::equal(bytes.begin(), bytes.begin() + 4, "glTF");
+  // A .glb's JSON chunk, or the whole .gltf (a chunk length beyond the file
+  // is left for tinygltf to report).
+  uint32_t jsonBytes = 0;
+  if (binary && bytes.size() >= 20) std::memcpy(&jsonBytes, &bytes[12], 4);
+  const size_t jsonStart = binary ? 20 : 0;
+  const size_t jsonSize = binary ? std::min<size_t>(jsonBytes, bytes.size() - std::min<size_t>(bytes.size(), 20)) : bytes.size();
+  if (!nestingWithinLimit(bytes.data() + std::min(jsonStart, bytes.size()), jsonSize))
+    return invalid(path + ": its JSON nests deeper than " + std::to_string(kMaxJsonDepth) + " levels");
   const std::vector<HeldIndices> held = holdDatalessIndices(bytes, binary);
   const bool ok = binary
       ? loader.LoadBinaryFromMemory(&model, &error, &warnings, bytes.data(), unsigned(bytes.size()), folderOf(path))
