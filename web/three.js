@@ -7,6 +7,7 @@
 //   scene.add(model);                 // usable at once, refined in place
 //   await model.userData.loaded;      // resolves when the last byte is applied
 //   const geometry = loader.loadGeometry(url);   // or a BufferGeometry, refined in place
+//   loader.parseGeometry(bytes, { geometry, attributes });  // a stream in memory into a given geometry (kdmesh/gltf)
 //
 // Decoding runs in a pool of workers (setWorkerLimit, default 4), started
 // from the worker's source bundled in the package, so no bundler needs

@@ -9,8 +9,10 @@
 #include <fstream>
 #include <map>
 #include <string>
+#include <tuple>
 #include <vector>
 
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include "gltf/gltf_internal.h"
@@ -705,6 +707,47 @@ TEST_F(GltfTest, AComplexBecomesASceneOfOneMeshWithItsAttributes) {
   for (size_t p = 0; p < 3; ++p) EXPECT_TRUE(drawnBy(scene, primitives[p]) == drawnBy(out, out.meshes[0].primitives[p])) << p;
   c.tetrahedra = {0, 1, 2, 4};
   EXPECT_EQ(gltf::writeComplexScene(at("tetrahedra.glb"), c, notes).code, ErrorCode::InvalidArgument);
+}
+
+}  // namespace
+}  // namespace kdmesh::test
+
+#ifndef KDMESH_CLI_PATH
+#error "KDMESH_CLI_PATH must name the kdmesh executable"
+#endif
+
+namespace kdmesh::test {
+namespace {
+
+// Runs the CLI in the test's folder; returns its exit status and stderr.
+std::pair<int, std::string> runCli(const fs::path& dir, const std::string& args) {
+  const std::string err = (dir / "stderr.txt").string();
+  const std::string command = "cd '" + dir.string() + "' && exec '" KDMESH_CLI_PATH "' " + args + " </dev/null >/dev/null 2>'" + err + "'";
+  const int status = std::system(command.c_str());
+  std::ifstream in(err);
+  return {WIFEXITED(status) ? WEXITSTATUS(status) : -1, std::string(std::istreambuf_iterator<char>(in), {})};
+}
+
+TEST_F(GltfTest, TheCommandLineEncodesAndDecodesScenes) {
+  save(testScene(), "scene.glb");
+  auto [code, err] = runCli(dir_, "encode scene.glb -o scene.kdm.glb");
+  EXPECT_EQ(code, 0) << err;
+  EXPECT_NE(err.find("scene.kdm.glb: 6 streams of 6 primitives"), std::string::npos) << err;
+  std::tie(code, err) = runCli(dir_, "decode scene.kdm.glb -o plain.gltf -q");
+  EXPECT_EQ(code, 0) << err;
+  EXPECT_TRUE(err.empty()) << err;
+  const Model in = load("scene.glb"), out = load("plain.gltf");
+  for (size_t m = 0; m < in.meshes.size(); ++m)
+    for (size_t p = 0; p < in.meshes[m].primitives.size(); ++p)
+      EXPECT_TRUE(drawnBy(in, in.meshes[m].primitives[p]) == drawnBy(out, out.meshes[m].primitives[p]));
+  // Mixed kinds of files and options for the other kind: one-line errors.
+  for (const char* args : {"encode scene.glb -o scene.kdm", "decode scene.kdm.glb -o scene.ply",
+                           "decode scene.kdm.glb -o x.glb --bytes 100", "encode scene.glb -o x.glb --weld"}) {
+    std::tie(code, err) = runCli(dir_, args);
+    EXPECT_EQ(code, 1) << args;
+    EXPECT_EQ(err.rfind("kdmesh: error: ", 0), 0u) << args << ": " << err;
+    EXPECT_EQ(std::count(err.begin(), err.end(), '\n'), 1) << err;
+  }
 }
 
 }  // namespace
