@@ -12,7 +12,7 @@ import validator from 'gltf-validator';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { decode } from 'kdmesh';
 import { KDMeshGLTFExtension, EXTENSION_NAME } from 'kdmesh/gltf';
-import { cli, workDir } from './fixtures.mjs';
+import { cli, colouredTorus, workDir, writePly } from './fixtures.mjs';
 import { writeTestScene, readGlb } from './gltf-fixtures.mjs';
 
 const input = join(workDir, 'scene.glb');
@@ -24,6 +24,11 @@ before(() => {
   execFileSync(cli, ['encode', input, '-o', join(workDir, 'streams.kdm.gltf'), '--kdm-files', '-q']);
   execFileSync(cli, ['encode', input, '-o', join(workDir, 'uris.kdm.glb'), '--kdm-files', '-q']);
   execFileSync(cli, ['decode', join(workDir, 'scene.kdm.glb'), '-o', join(workDir, 'plain.glb'), '-q']);
+  execFileSync(cli, ['encode', input, '-o', join(workDir, 'fallback.kdm.glb'), '--fallback', '-q']);
+  // A complex written as a scene: the torus of the PLY tests, with its attributes.
+  writePly(join(workDir, 'torus.ply'), colouredTorus());
+  execFileSync(cli, ['encode', join(workDir, 'torus.ply'), '-o', join(workDir, 'torus.kdm'), '-q']);
+  execFileSync(cli, ['decode', join(workDir, 'torus.kdm'), '-o', join(workDir, 'torus.glb'), '-q']);
 });
 
 async function validate(path) {
@@ -38,11 +43,24 @@ function errorsOf(report) {
 }
 
 test('the validator finds no errors in the input, the encoded scenes and the decoded scene', async () => {
-  for (const name of ['scene.glb', 'scene.kdm.glb', 'streams.kdm.gltf', 'plain.glb']) {
+  for (const name of ['scene.glb', 'scene.kdm.glb', 'streams.kdm.gltf', 'plain.glb', 'fallback.kdm.glb', 'torus.glb']) {
     const report = await validate(join(workDir, name));
     assert.deepEqual(errorsOf(report), [], name);
     assert.ok(report.info.totalVertexCount > 0 || name.includes('kdm'), name);
   }
+});
+
+test('a fallback is not required, and a complex\'s attributes get their glTF semantics', () => {
+  const { json } = readGlb(readFileSync(join(workDir, 'fallback.kdm.glb')));
+  assert.deepEqual(json.extensionsUsed, [EXTENSION_NAME]);
+  assert.equal(json.extensionsRequired, undefined);
+  const [torus] = json.meshes[0].primitives;
+  assert.ok(torus.extensions[EXTENSION_NAME]);
+  assert.ok(json.accessors[torus.attributes.POSITION].bufferView !== undefined);
+  const scene = readGlb(readFileSync(join(workDir, 'torus.glb'))).json;
+  const [primitive] = scene.meshes[0].primitives;
+  assert.deepEqual(Object.keys(primitive.attributes).sort(), ['COLOR_0', 'NORMAL', 'POSITION', 'TEXCOORD_0', '_LABEL']);
+  assert.equal(scene.accessors[primitive.attributes.COLOR_0].normalized, true);
 });
 
 test('the validator reports errors where there are some', async () => {
