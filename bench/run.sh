@@ -84,6 +84,10 @@ if [ "$quick" = 0 ]; then
   echo
   node bench/browser-bench.mjs --throttle 10000 --runs 5
   echo
+  echo "## glTF scene: Draco, meshopt and kdmesh through GLTFLoader"
+  echo
+  node bench/gltf-bench.mjs --throttle 10000 --runs 3
+  echo
   echo "Pictures of the dragon's early levels, predicted and cell-centre placement (docs/coarse-levels/):"
   echo
   node bench/coarse-levels.mjs --out build-bench/coarse-levels 8000 16000

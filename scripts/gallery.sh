@@ -2,8 +2,9 @@
 # Encodes the viewer's default gallery into out/ (skipping models already
 # encoded): the Stanford dragon mesh, the dragon with vertex colours, its
 # vertices as a point cloud, a triangle soup (the triceratops with every
-# triangle on its own vertices) and a tetrahedral mesh (TetGen's Delaunay
-# tetrahedralization of a ball).
+# triangle on its own vertices), a tetrahedral mesh (TetGen's Delaunay
+# tetrahedralization of a ball) and the coloured dragon as a glTF scene
+# with a kdmesh stream (KDMESH_progressive_compression).
 set -eu
 cd "$(dirname "$0")/.."
 sh scripts/models.sh
@@ -64,3 +65,9 @@ encode dragon-colours.kdm build/models/dragon-colours.ply --bits 12
 encode dragon-points.kdm build/models/dragon_vrip.ply --bits 12 --points-only
 encode triceratops-soup.kdm build/models/triceratops-soup.obj --bits 12
 encode ball-tetrahedra.kdm build/models/ball10k.1.ele --bits 16
+# The coloured dragon as plain glTF (its 12-bit positions, COLOR_0), then
+# with its primitive as a kdmesh stream.
+if [ ! -f build/models/dragon-colours.glb ] || [ out/dragon-colours.kdm -nt build/models/dragon-colours.glb ]; then
+  ./build/kdmesh decode out/dragon-colours.kdm -o build/models/dragon-colours.glb -q
+fi
+encode dragon-colours.kdm.glb build/models/dragon-colours.glb --bits 12

@@ -3,7 +3,7 @@
 # missing packages are installed, so repeated runs cost a dpkg query.
 set -eu
 
-APT_PACKAGES="cmake g++ make libgtest-dev libcli11-dev libbenchmark-dev draco libdraco-dev libcgal-demo time emscripten tetgen chromium clang"
+APT_PACKAGES="cmake g++ make libgtest-dev libcli11-dev libbenchmark-dev draco libdraco-dev libcgal-demo time emscripten tetgen chromium clang libtinygltf-dev nlohmann-json3-dev gltfpack"
 
 missing=""
 for pkg in $APT_PACKAGES; do

@@ -7,7 +7,8 @@
 // bundled into one classic script, see scripts/bundle-worker.mjs) through a
 // Blob URL, or as a module worker from a URL given to setWorkerUrl().
 //
-// Messages in:  {type: 'start', wasm (a WebAssembly.Module), limits?, coarsePlacement?, tetrahedra?, geomorph?}
+// Messages in:  {type: 'start', wasm (a WebAssembly.Module), limits?, coarsePlacement?, tetrahedra?, geomorph?,
+//               normals? (false: compute none)}
 //               (a new stream), {type: 'bytes', bytes}, {type: 'end'},
 //               {type: 'next'} (the page is ready for a snapshot)
 // Messages out: {type: 'header', header}, {type: 'snapshot', model} (the
@@ -163,7 +164,7 @@ function sendSnapshot() {
     boundary: boundaryInPlace, tetrahedronEdges: tetrahedronEdgesInPlace,
     bounds: bounds(positions),
     normals: streamNormals(attributes) ??
-      (drawnTriangles.length ? vertexNormals(positions, drawnTriangles) : new Float32Array(0)),
+      (drawnTriangles.length && job.normals ? vertexNormals(positions, drawnTriangles) : new Float32Array(0)),
     parents: geomorph ? decoder.parents() : new Uint32Array(0),
     progress: decoder.progress,
   };
@@ -230,12 +231,13 @@ function schedule() {
   setTimeout(() => pump(current), 0);
 }
 
-async function start({ wasm, limits, coarsePlacement, tetrahedra, geomorph }) {
+async function start({ wasm, limits, coarsePlacement, tetrahedra, geomorph, normals }) {
   const current = (job = {
     decoder: null, done: false, wanted: true, changed: false, headerSent: false, pending: [], ending: false, pumping: false,
     decodeMs: 0, handOverMs: 0,  // decoding since the last snapshot, and that snapshot's cost (snapshotDue())
     wireframe: tetrahedra === 'wireframe',  // also send the edges of the tetrahedra
     geomorph: Boolean(geomorph),            // also send every vertex's parent
+    normals: normals !== false,             // compute normals for streams without their own
   });
   try {
     if (!wasmSet) {

@@ -10,7 +10,7 @@
 //
 // Routes: /            the viewer (web/index.html) and its modules
 //         /vendor/three/...   three.js from node_modules
-//         /models/            JSON list of the .kdm files in --root
+//         /models/            JSON list of the .kdm, .glb and .gltf files in --root
 //         /models/NAME?throttle=KBPS   a model, paced to KBPS kilobits per second
 //         POST /encode?name=FILE.obj   encodes the body with build/kdmesh, returns .kdm
 //                  (same-origin pages on this machine only; limited size, time and count)
@@ -342,11 +342,12 @@ async function encode(request, response, name, state) {
   }
 }
 
-// The .kdm files directly in `root` with their sizes: regular files only,
-// links followed only when they stay inside `root`.
+// The .kdm files and glTF scenes (.glb, .gltf) directly in `root` with
+// their sizes: regular files only, links followed only when they stay
+// inside `root`.
 async function listModels(root) {
   let names;
-  try { names = (await fs.readdir(root)).filter((n) => n.endsWith('.kdm')).sort(); } catch { return []; }
+  try { names = (await fs.readdir(root)).filter((n) => /\.(kdm|glb|gltf)$/.test(n)).sort(); } catch { return []; }
   const list = [];
   for (const name of names) {
     const file = await regularFileWithin(root, encodeURIComponent(name));

@@ -43,6 +43,17 @@ export interface LoadOptions<T> {
   coarsePlacement?: 'predicted' | 'centre';
 }
 
+/** loadGeometry and parseGeometry also take: */
+export interface GeometryOptions extends LoadOptions<BufferGeometry> {
+  /** Refine this geometry (its attributes and index are replaced) instead of a new one. */
+  geometry?: BufferGeometry;
+  /**
+   * The geometry attribute of each stream attribute, by the stream's name: only these are set, and
+   * no normals are computed (kdmesh/gltf names glTF semantics so).
+   */
+  attributes?: Record<string, { name: string; normalized: boolean }>;
+}
+
 export interface ProgressiveOptions extends LoadOptions<Group> {
   tetrahedra?: 'boundary' | 'wireframe';
   geomorph?: boolean;
@@ -99,7 +110,9 @@ export class KDMeshLoader extends Loader<Group> {
     onError?: (error: unknown) => void): Group;
   parse(buffer: ArrayBuffer | ArrayBufferView, onLoad?: (group: Group) => void, onError?: (error: unknown) => void): Group;
   loadProgressive(url: string, options?: ProgressiveOptions): Group & { userData: ModelUserData };
-  loadGeometry(url: string, options?: LoadOptions<BufferGeometry>): BufferGeometry & { userData: GeometryUserData };
+  loadGeometry(url: string, options?: GeometryOptions): BufferGeometry & { userData: GeometryUserData };
+  /** loadGeometry for a whole stream already in memory. */
+  parseGeometry(buffer: ArrayBuffer | ArrayBufferView, options?: GeometryOptions): BufferGeometry & { userData: GeometryUserData };
   abort(): this;
   dispose(): this;
 }

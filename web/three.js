@@ -7,6 +7,7 @@
 //   scene.add(model);                 // usable at once, refined in place
 //   await model.userData.loaded;      // resolves when the last byte is applied
 //   const geometry = loader.loadGeometry(url);   // or a BufferGeometry, refined in place
+//   loader.parseGeometry(bytes, { geometry, attributes });  // a stream in memory into a given geometry (kdmesh/gltf)
 //
 // Decoding runs in a pool of workers (setWorkerLimit, default 4), started
 // from the worker's source bundled in the package, so no bundler needs
@@ -385,9 +386,14 @@ class GroupView {
 // tetrahedra) when the complete model has any, else its edges; a point
 // cloud has no index. userData.primitive ('triangles', 'lines' or
 // 'points') says which, once the header has arrived.
+//
+// `attributes`, when given, names the geometry attribute of each stream
+// attribute, { [streamName]: { name, normalized } }: those alone are set,
+// and no normals are computed (as glTF primitives are drawn, see kdmesh/gltf).
 class GeometryView {
-  constructor(geometry) {
+  constructor(geometry, attributes = null) {
     this.object = geometry;
+    this.attributes = attributes;
     this.list = -1;  // which of listsOf() the index holds (-1: none)
   }
 
@@ -408,7 +414,7 @@ class GeometryView {
       attribute.needsUpdate = true;
     };
     update('position', storageOf(model.positions), model.positions.length, 3);
-    for (const { name, array, itemSize, normalized } of vertexAttributesOf(model))
+    for (const { name, array, itemSize, normalized } of this.#vertexAttributes(model))
       update(name, storageOf(array), array.length, itemSize, normalized);
     let count = model.vertexCount;
     if (this.list >= 0) {
@@ -423,6 +429,12 @@ class GeometryView {
   }
 
   release() {}
+
+  #vertexAttributes(model) {
+    if (!this.attributes) return vertexAttributesOf(model);
+    return Object.entries(model.attributes).filter(([name]) => Object.hasOwn(this.attributes, name))
+      .map(([name, { array, itemSize }]) => ({ ...this.attributes[name], array, itemSize }));
+  }
 }
 
 export class KDMeshLoader extends Loader {
@@ -636,9 +648,23 @@ export class KDMeshLoader extends Loader {
    * whose vertexColors is set).
    */
   loadGeometry(url, options = {}) {
-    const geometry = new BufferGeometry();
-    this.#run(url, null, options, new GeometryView(geometry));
+    const geometry = options.geometry ?? new BufferGeometry();
+    this.#run(url, null, options, this.#geometryView(geometry, options));
     return geometry;
+  }
+
+  /** Like loadGeometry, for a whole stream already in memory (refined as the worker decodes it). */
+  parseGeometry(buffer, options = {}) {
+    const geometry = options.geometry ?? new BufferGeometry();
+    const bytes = ArrayBuffer.isView(buffer) ? new Uint8Array(buffer.buffer, buffer.byteOffset, buffer.byteLength) : new Uint8Array(buffer);
+    this.#run(null, bytes.slice(), options, this.#geometryView(geometry, options));  // the worker takes the copy
+    return geometry;
+  }
+
+  // options.geometry: refine this geometry (its attributes are replaced);
+  // options.attributes: see GeometryView.
+  #geometryView(geometry, options) {
+    return new GeometryView(geometry, options.attributes ?? null);
   }
 
   /** Stops every load in flight; each keeps its current level and rejects with code 'aborted'. */
@@ -814,7 +840,8 @@ export class KDMeshLoader extends Loader {
       acquired.onerror = (event) => finish(new KdmeshError('worker-failed', `the kdmesh worker failed: ${event.message || 'no message'}`));
       const limits = options.limits ?? this.decoderLimits;
       acquired.postMessage({ type: 'start', wasm, limits, coarsePlacement: options.coarsePlacement,
-                             tetrahedra: options.tetrahedra, geomorph: options.geomorph });
+                             tetrahedra: options.tetrahedra, geomorph: options.geomorph,
+                             normals: !options.attributes });
       for (const piece of early) acquired.postMessage({ type: 'bytes', bytes: piece }, [piece.buffer]);
       early.length = 0;
       worker = acquired;

@@ -1,9 +1,12 @@
-// The kdmesh viewer: streams a .kdm model into three.js and shows it refine.
+// The kdmesh viewer: streams a .kdm model (or a glTF scene whose primitives
+// are kdmesh streams, see kdmesh/gltf) into three.js and shows it refine.
 // Query: ?model=NAME_OR_URL&throttle=KBPS. State for scripts and tests lives
 // in window.kdmeshViewer.
 import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
+import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 import { GpuFence, KDMeshLoader } from 'kdmesh/three';
+import { KDMeshGLTFExtension } from 'kdmesh/gltf';
 import { modelChecksum } from './model-checksum.js';
 
 const $ = (id) => document.getElementById(id);
@@ -14,6 +17,8 @@ const viewer = (window.kdmeshViewer = {
   pointCount: 0, bytesReceived: 0, bytesExpected: 0, level: 0, error: null, firstRenderMs: null,
   // Names of the model's vertex attributes ('color' draws as vertex colours).
   attributes: [],
+  // A glTF scene: its compressed primitives (streams) and those complete.
+  streams: 0, streamsComplete: 0,
   // The complete model's totals, from the stream's header.
   levelCount: 0, vertexTotal: 0,
   // Since the load began: the first and the last level drawn, and the last
@@ -25,7 +30,7 @@ const viewer = (window.kdmeshViewer = {
   // when read: hashing the dragon's arrays takes ~60 ms, a long task the
   // page itself has no use for.
   get checksum() {
-    return this.state === 'complete' ? modelChecksum(current.userData.stats.model) : null;
+    return this.state === 'complete' && current.userData.stats.model ? modelChecksum(current.userData.stats.model) : null;
   },
   // Whether the drawn positions are the last level's exactly (for tests:
   // geomorphs must end where the model is).
@@ -247,7 +252,7 @@ function start(load) {
   const began = (loadBegan = performance.now());
   Object.assign(viewer, {
     state: 'loading', refinements: 0, error: null, firstRenderMs: null, completeMs: null, finalRenderMs: null, bytesReceived: 0,
-    bytesExpected: 0, levelCount: 0, vertexTotal: 0, levelsSeen: [], longTasks: [], attributes: [],
+    bytesExpected: 0, levelCount: 0, vertexTotal: 0, levelsSeen: [], longTasks: [], attributes: [], streams: 0, streamsComplete: 0,
   });
   pendingStatus = pendingProgress = null;
   $('progress').value = $('decoded').value = 0;
@@ -256,6 +261,7 @@ function start(load) {
   const isCurrent = () => group === current;
   const options = {
     signal: controller.signal,
+    isCurrent,
     geomorph: $('geomorph').checked,
     // ?placement=centre draws unfinished vertices at their cells' centres.
     coarsePlacement: params.get('placement') === 'centre' ? 'centre' : 'predicted',
@@ -302,13 +308,70 @@ function start(load) {
   });
 }
 
+// .glb and .gltf files are scenes (see loadScene).
+const isScene = (name) => /\.(glb|gltf)$/i.test(name.split('?')[0]);
+
+// What the status line says of a scene: its streams and their vertices and
+// triangles so far.
+function describeScene(group) {
+  let vertices = 0, triangles = 0;
+  group.traverse((object) => {
+    const model = object.geometry?.userData.stats?.model;
+    if (model) {
+      vertices += model.vertexCount;
+      triangles += model.triangles.length / 3;
+    }
+  });
+  Object.assign(viewer, { vertexCount: vertices, triangleCount: triangles });
+  const count = (n) => n.toLocaleString('en-US');
+  return `${(viewer.bytesReceived / 1024).toFixed(0)} KiB · glTF scene · ${viewer.streamsComplete} of ${viewer.streams} kdmesh streams complete` +
+    ` · ${count(vertices)} vertices · ${count(triangles)} triangles`;
+}
+
+// A glTF scene through GLTFLoader with kdmesh/gltf, as a group that holds
+// the scene once it is built; its compressed primitives refine in place in
+// the loader's workers. userData: loaded, stats (refinements, complete).
+function loadScene(url, options) {
+  const group = new THREE.Group();
+  const stats = { refinements: 0, complete: false, model: null };
+  const refined = (geometry, geometryStats) => {
+    stats.refinements += 1;
+    if (geometryStats.complete) viewer.streamsComplete += 1;
+    viewer.refinements = stats.refinements;
+    if (!framed) { frame(group); framed = true; }
+    queueStatus(describeScene(group), { decoded: viewer.streams ? viewer.streamsComplete / viewer.streams : 1 });
+  };
+  const gltfLoader = new GLTFLoader().register((parser) =>
+    new KDMeshGLTFExtension(parser, { loader, signal: options.signal, onRefine: (geometry, s) => options.isCurrent() && refined(geometry, s) }));
+  const loaded = gltfLoader.loadAsync(url, (event) => options.onProgress({ bytesReceived: event.loaded, bytesExpected: event.total }))
+    .then(async (gltf) => {
+      group.add(gltf.scene);
+      viewer.streams = gltf.userData.kdmesh?.streams ?? 0;
+      if (!viewer.streams) {
+        stats.refinements = viewer.refinements = 1;  // a plain scene is drawn whole
+        frame(group);
+        framed = true;
+      }
+      await gltf.userData.kdmesh?.loaded;
+      stats.complete = true;
+      if (options.isCurrent()) {
+        viewer.completeMs = performance.now() - loadBegan;
+        viewer.state = 'complete';
+        queueStatus(describeScene(group), { downloaded: 1, decoded: 1 });
+      }
+      return group;
+    });
+  Object.assign(group.userData, { loaded, stats });
+  return group;
+}
+
 // A gallery model (by menu value) or a URL, paced by the throttle menu.
 function loadUrl(url) {
   const throttle = Number($('throttle').value);
   const full = throttle > 0 ? `${url}${url.includes('?') ? '&' : '?'}throttle=${throttle}` : url;
   viewer.source = url;
   reloadCurrent = () => loadUrl(url);
-  start((options) => loader.loadProgressive(full, options));
+  start((options) => (isScene(url) ? loadScene : loader.loadProgressive.bind(loader))(full, options));
 }
 
 // A file already in the menu (see openFile).
@@ -318,7 +381,8 @@ function loadFile(value) {
   reloadCurrent = () => loadFile(value);
   const url = URL.createObjectURL(new Blob([bytes]));
   start((options) => {
-    const group = loader.loadProgressive(url, options);
+    // GLTFLoader tells a .glb from a .gltf by its bytes; a .gltf must hold its buffers (data URIs).
+    const group = isScene(name) ? loadScene(url, options) : loader.loadProgressive(url, options);
     group.userData.loaded.finally(() => URL.revokeObjectURL(url)).catch(() => {});
     return group;
   });
@@ -332,7 +396,7 @@ const firstLine = (text) => text.trim().split('\n')[0].slice(0, 300);
 async function openFile(file) {
   controller?.abort();
   let bytes = new Uint8Array(await file.arrayBuffer());
-  if (!file.name.toLowerCase().endsWith('.kdm')) {
+  if (!file.name.toLowerCase().endsWith('.kdm') && !isScene(file.name)) {
     Object.assign(viewer, { state: 'encoding', error: null, source: file.name });
     showStatus(`encoding ${file.name} on the server…`);
     let response;

@@ -17,6 +17,7 @@
 
 #include <unistd.h>
 
+#include "kdmesh/gltf.h"
 #include "kdmesh/io.h"
 #include "kdmesh/kdmesh.h"
 
@@ -152,6 +153,9 @@ struct EncodeArgs {
   // quarters of the machine's memory.
   static constexpr uint64_t kMachineMemory = UINT64_MAX;
   uint64_t maxMemory = kMachineMemory;
+  bool bitsGiven = false;  // --bits on the command line: glTF positions go to the grid
+  bool fallback = false;
+  bool kdmFiles = false;
 };
 
 // Three quarters of the machine's physical memory, or 0 (no limit) where
@@ -162,7 +166,43 @@ uint64_t defaultMemoryLimit() {
   return uint64_t(pages) * uint64_t(pageSize) / 4 * 3;
 }
 
+void reportGltf(const std::string& output, const kdmesh::gltf::Summary& summary, const char* verb, double seconds) {
+  if (gQuiet) return;
+  std::fprintf(stderr, "%s: %s of %s, %s, %" PRIu64 " stream bytes [%s %.3fs]\n", output.c_str(),
+               counted(summary.streams, "stream", "streams").c_str(),
+               counted(summary.primitives, "primitive", "primitives").c_str(),
+               counted(size_t(summary.vertices), "vertex", "vertices").c_str(), summary.streamBytes, verb, seconds);
+}
+
+// A glTF scene: every primitive becomes a kdmesh stream (kdmesh/gltf.h),
+// positions bit for bit unless --bits is given.
+int runEncodeGltf(const EncodeArgs& args) {
+  const auto start = Clock::now();
+  kdmesh::gltf::EncodeOptions options;
+  options.stream.exact = args.exact || !args.bitsGiven;
+  options.stream.bits = args.bits;
+  options.stream.chunkBytes = args.chunkBytes;
+  options.stream.maxMemoryBytes =
+      args.maxMemory == EncodeArgs::kMachineMemory ? defaultMemoryLimit() : args.maxMemory;
+  options.fallback = args.fallback;
+  options.separateStreams = args.kdmFiles;
+  kdmesh::io::Notes notes;
+  kdmesh::gltf::Summary summary;
+  const kdmesh::Status s = kdmesh::gltf::encodeFile(args.input, args.output, options, notes, &summary);
+  for (const std::string& n : notes) note(args.input + ": " + n);
+  if (!s.ok()) return fail(s, "cannot encode " + args.input);
+  reportGltf(args.output, summary, "encode", secondsSince(start));
+  return 0;
+}
+
 int runEncode(const EncodeArgs& args) {
+  if (kdmesh::gltf::isGltfPath(args.input) || kdmesh::gltf::isGltfPath(args.output)) {
+    if (!kdmesh::gltf::isGltfPath(args.input) || !kdmesh::gltf::isGltfPath(args.output))
+      return fail("a glTF scene encodes to a glTF scene: give .glb or .gltf for both input and output");
+    if (args.pointsOnly || args.weld) return fail("--points-only and --weld do not apply to glTF scenes");
+    return runEncodeGltf(args);
+  }
+  if (args.fallback || args.kdmFiles) return fail("--fallback and --kdm-files apply to glTF scenes only");
   const auto start = Clock::now();
   kdmesh::Complex complex;
   kdmesh::io::Notes notes;
@@ -254,7 +294,21 @@ std::string keepWhatTheFormatHolds(kdmesh::io::Format format, kdmesh::Complex& c
   return dropped;
 }
 
+int runDecodeGltf(const DecodeArgs& args) {
+  if (!kdmesh::gltf::isGltfPath(args.output)) return fail("a glTF scene decodes to a glTF scene: give a .glb or .gltf output");
+  if (args.bytes > 0) return fail("--bytes applies to .kdm streams only");
+  const auto start = Clock::now();
+  kdmesh::io::Notes notes;
+  kdmesh::gltf::Summary summary;
+  const kdmesh::Status s = kdmesh::gltf::decodeFile(args.input, args.output, notes, &summary);
+  for (const std::string& n : notes) note(args.input + ": " + n);
+  if (!s.ok()) return fail(s, "cannot decode " + args.input);
+  reportGltf(args.output, summary, "decode", secondsSince(start));
+  return 0;
+}
+
 int runDecode(const DecodeArgs& args) {
+  if (kdmesh::gltf::isGltfPath(args.input)) return runDecodeGltf(args);
   std::vector<uint8_t> bytes;
   std::string error;
   if (!readBytes(args.input, bytes, error)) return fail(error);
@@ -274,7 +328,7 @@ int runDecode(const DecodeArgs& args) {
     const std::string dropped = keepWhatTheFormatHolds(outputFormat, complex);
     if (!dropped.empty()) note(args.output + ": left out " + dropped + " of the prefix, which " + formatName + " cannot hold");
   }
-  // Only PLY holds vertex attributes.
+  // Only PLY and glTF hold vertex attributes.
   if (outputFormat != kdmesh::io::Format::Ply && outputFormat != kdmesh::io::Format::Unknown &&
       !complex.attributes.empty()) {
     std::string names;
@@ -282,15 +336,23 @@ int runDecode(const DecodeArgs& args) {
     note(args.output + ": left out the vertex attributes " + names + ", which " + formatName + " cannot hold");
     complex.attributes.clear();
   }
-  // PLY, Medit and TetGen hold simplex labels.
-  if (outputFormat != kdmesh::io::Format::Ply && outputFormat != kdmesh::io::Format::Medit &&
-      outputFormat != kdmesh::io::Format::TetGen && outputFormat != kdmesh::io::Format::Unknown &&
-      !complex.labels.empty()) {
-    note(args.output + ": left out the simplex labels, which " + formatName + " cannot hold");
+  const bool gltfOutput = kdmesh::gltf::isGltfPath(args.output);
+  // PLY, Medit and TetGen hold simplex labels; glTF does not.
+  if (!complex.labels.empty() &&
+      (gltfOutput || (outputFormat != kdmesh::io::Format::Ply && outputFormat != kdmesh::io::Format::Medit &&
+                      outputFormat != kdmesh::io::Format::TetGen && outputFormat != kdmesh::io::Format::Unknown))) {
+    note(args.output + ": left out the simplex labels, which " + (gltfOutput ? std::string("glTF") : formatName) +
+         " cannot hold");
     complex.labels = {};
   }
-  if (auto s = kdmesh::io::writeFile(args.output, complex, writeOptions); !s.ok())
+  if (gltfOutput) {
+    kdmesh::io::Notes notes;
+    const kdmesh::Status s = kdmesh::gltf::writeComplexScene(args.output, complex, notes);
+    for (const std::string& n : notes) note(args.output + ": " + n);
+    if (!s.ok()) return fail(s, args.output);
+  } else if (auto s = kdmesh::io::writeFile(args.output, complex, writeOptions); !s.ok()) {
     return fail(s, args.output);
+  }
   if (!gQuiet)
     std::fprintf(stderr, "%s: %zu vertices from %zu bytes%s [decode %.3fs]\n", args.output.c_str(),
                  complex.vertexCount(), bytes.size(), prefix ? " (prefix)" : "", seconds);
@@ -496,12 +558,12 @@ int main(int argc, char** argv) {
 
   EncodeArgs encodeArgs;
   CLI::App* encode = app.add_subcommand(
-      "encode", "Compress a PLY, OBJ, OFF, XYZ, STL, Medit, TetGen or VTK file to .kdm");
+      "encode", "Compress a PLY, OBJ, OFF, XYZ, STL, Medit, TetGen or VTK file to .kdm, or the geometry of a glTF scene");
   encode->add_option("input", encodeArgs.input,
-                     "Input file (.ply .obj .off .xyz .stl .mesh .node/.ele .vtk)")
+                     "Input file (.ply .obj .off .xyz .stl .mesh .node/.ele .vtk, or .glb .gltf)")
       ->required()
       ->check(CLI::ExistingFile);
-  encode->add_option("-o,--output", encodeArgs.output, "Output .kdm file")->required();
+  encode->add_option("-o,--output", encodeArgs.output, "Output .kdm file (.glb or .gltf for a glTF scene)")->required();
   auto* bits = encode->add_option("--bits", encodeArgs.bits,
                                   "Grid bits of the longest bounding-box axis (1-30)")
                    ->check(CLI::Range(1, 30))
@@ -519,12 +581,18 @@ int main(int argc, char** argv) {
                      "Refuse inputs whose encoding would take more memory than this (e.g. 4GB; 0: no "
                      "limit; default: three quarters of the machine's memory)")
       ->transform(CLI::AsSizeValue(false));
+  encode->add_flag("--fallback", encodeArgs.fallback,
+                   "glTF: keep the uncompressed accessors too, for loaders without the extension");
+  encode->add_flag("--kdm-files", encodeArgs.kdmFiles,
+                   "glTF: write each stream to a .kdm file next to the output, for pages to stream");
 
   DecodeArgs decodeArgs;
   CLI::App* decode = app.add_subcommand("decode", "Decompress a .kdm file (or a prefix of it)");
-  decode->add_option("input", decodeArgs.input, "Input .kdm file")->required()->check(CLI::ExistingFile);
+  decode->add_option("input", decodeArgs.input, "Input .kdm file, or a glTF scene with kdmesh streams")
+      ->required()
+      ->check(CLI::ExistingFile);
   decode->add_option("-o,--output", decodeArgs.output,
-                     "Output file (.ply .obj .off .xyz .mesh .node .vtk)")
+                     "Output file (.ply .obj .off .xyz .mesh .node .vtk .glb .gltf)")
       ->required();
   decode->add_option("--bytes", decodeArgs.bytes,
                      "Decode only the first N bytes: the model as a viewer sees it after N bytes");
@@ -549,6 +617,7 @@ int main(int argc, char** argv) {
     return e.get_exit_code();
   }
   try {
+    encodeArgs.bitsGiven = bits->count() > 0;
     if (encode->parsed()) return runEncode(encodeArgs);
     if (decode->parsed()) return runDecode(decodeArgs);
     return runInfo(infoInput, infoJson, infoLevels);

@@ -11,6 +11,7 @@ import { decode } from 'kdmesh';
 import { startServer } from '../../web/server.mjs';
 import { modelChecksum } from '../../web/model-checksum.js';
 import { root, cli, colouredTorus, writePly } from '../js/fixtures.mjs';
+import { writeTestScene } from '../js/gltf-fixtures.mjs';
 
 const models = mkdtempSync(join(tmpdir(), 'kdmesh-browser-'));
 const screenshots = join(root, 'build', 'screenshots');
@@ -30,6 +31,9 @@ before(async () => {
   // A torus with vertex colours, red on one side and blue on the other.
   writePly(join(models, 'coloured.ply'), colouredTorus());
   execFileSync(cli, ['encode', join(models, 'coloured.ply'), '-o', join(models, 'coloured.kdm'), '--bits', '12', '-q']);
+  // A glTF scene whose torus, line loop and point cloud are kdmesh streams.
+  writeTestScene(join(models, 'input-scene.glb'));
+  execFileSync(cli, ['encode', join(models, 'input-scene.glb'), '-o', join(models, 'scene.kdm.glb'), '-q']);
   execFileSync('mkdir', ['-p', screenshots]);
   server = await startServer({ port: 0, root: models, host: '127.0.0.1' });
   base = `http://127.0.0.1:${server.address().port}`;
@@ -224,6 +228,27 @@ test('a model with vertex colours shows them, and the status names its attribute
   assert.deepEqual(state.attributes, ['color', 'normal', 'uv', 'label']);
   assert.match(await page.$eval('#status', (status) => status.textContent), /· color, normal, uv, label ·/);
   assert.ok(vivid.red > 500 && vivid.blue > 500, `vivid pixels: ${JSON.stringify(vivid)}`);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('a glTF scene from the gallery and from the file picker: its streams complete and it is drawn', async () => {
+  const { page, errors } = await openViewer('model=scene.kdm.glb&throttle=2000');
+  await page.waitForFunction(() => window.kdmeshViewer.state === 'complete', null, { timeout: 60000 });
+  const state = await viewerState(page);
+  assert.equal(state.streams, 3);
+  assert.equal(state.streamsComplete, 3);
+  assert.ok(state.refinements >= 3, `refinements: ${state.refinements}`);
+  assert.equal(state.vertexCount, 24 * 40 + 16 + 300);
+  assert.ok(await page.evaluate(() => window.kdmeshViewer.modelPixels()) > 1000);
+  assert.match(await page.textContent('#status'), /3 of 3 kdmesh streams complete/);
+  const gallery = await page.$$eval('#model option', (options) => options.map((o) => o.value));
+  assert.ok(gallery.includes('scene.kdm.glb') && gallery.includes('input-scene.glb'));
+  // The same scene opened as a file: not sent to the encoder.
+  await page.route('**/encode?*', (route) => route.abort());
+  await page.setInputFiles('#file', { name: 'picked.kdm.glb', mimeType: 'model/gltf-binary', buffer: readFileSync(join(models, 'scene.kdm.glb')) });
+  await page.waitForFunction(() => window.kdmeshViewer.source === 'picked.kdm.glb' && window.kdmeshViewer.state === 'complete', null, { timeout: 60000 });
+  assert.equal((await viewerState(page)).streamsComplete, 3);
   assert.deepEqual(errors, []);
   await page.close();
 });

@@ -1,6 +1,6 @@
 // The npm package as an application meets it: `npm pack`, installed into a
 // fresh folder with the lowest supported three.js, a page importing
-// `kdmesh` and `kdmesh/three` bundled for production by vite, esbuild,
+// `kdmesh`, `kdmesh/three` and `kdmesh/gltf` bundled for production by vite, esbuild,
 // webpack and Rollup, served by vite's dev server, and copied as plain
 // files with an import map; each is served statically and loads a model in
 // headless chromium, which must decode it exactly as Node does.
@@ -37,6 +37,9 @@ before(async () => {
   copyFileSync(join(root, 'tests', 'consumer', 'page.js'), join(app, 'src', 'main.js'));
   copyFileSync(join(root, 'web', 'model-checksum.js'), join(app, 'src', 'model-checksum.js'));
   run(cli, ['encode', join(root, 'build', 'models', 'fandisk.off'), '-o', join(app, 'public', 'model.kdm'), '--bits', '12', '-q'], root);
+  // The same model as a glTF scene whose one primitive is a kdmesh stream.
+  run(cli, ['decode', join(app, 'public', 'model.kdm'), '-o', join(work, 'model.glb'), '-q'], root);
+  run(cli, ['encode', join(work, 'model.glb'), '-o', join(app, 'public', 'model.kdm.glb'), '--bits', '12', '-q'], root);
   decoded = await decode(readFileSync(join(app, 'public', 'model.kdm')));
   expected = modelChecksum(decoded);
   browser = await launchChromium();
@@ -53,6 +56,7 @@ const page = (script) => `<!doctype html><meta charset="utf-8"><link rel="icon" 
 function staticSite(dir, script) {
   writeFileSync(join(dir, 'index.html'), page(script));
   copyFileSync(join(app, 'public', 'model.kdm'), join(dir, 'model.kdm'));
+  copyFileSync(join(app, 'public', 'model.kdm.glb'), join(dir, 'model.kdm.glb'));
 }
 
 function listen(handler) {
@@ -66,7 +70,7 @@ function outputSize(dir) {
   const files = [];
   for (const name of readdirSync(dir, { recursive: true })) {
     const path = join(dir, name);
-    if (statSync(path).isFile() && !name.endsWith('.kdm') && !name.endsWith('.html')) {
+    if (statSync(path).isFile() && !name.endsWith('.kdm') && !name.endsWith('.glb') && !name.endsWith('.html')) {
       bytes += statSync(path).size;
       files.push(name);
     }
@@ -105,6 +109,7 @@ async function checkSite(t, dir, path = '/') {
     assert.equal(result.decode, expected, 'decode() on the main thread');
     assert.deepEqual(result.geometry, { vertices: decoded.vertexCount, indices: decoded.triangles.length, primitive: 'triangles' });
     assert.deepEqual(result.events, ['start', 'load', 'start', 'load'], 'LoadingManager events of the two loads');
+    assert.deepEqual(result.gltf, { streams: 1, vertices: decoded.vertexCount, indices: decoded.triangles.length }, 'the glTF scene');
   } finally {
     server.close();
   }
@@ -188,8 +193,10 @@ test('a plain static copy, with and without self-hosting', async (t) => {
   staticSite(site, `<script type="importmap">${JSON.stringify({
     imports: {
       three: '/node_modules/three/build/three.module.js',
+      'three/examples/jsm/': '/node_modules/three/examples/jsm/',
       kdmesh: '/node_modules/kdmesh/web/kdmesh.js',
       'kdmesh/three': '/node_modules/kdmesh/web/three.js',
+      'kdmesh/gltf': '/node_modules/kdmesh/web/gltf.js',
     },
   })}</script><script type="module" src="./main.js"></script>`);
   await checkSite(t, app, '/static/');

@@ -1,4 +1,4 @@
-// The TypeScript declarations of kdmesh and kdmesh/three: a program using
+// The TypeScript declarations of kdmesh, kdmesh/three and kdmesh/gltf: a program using
 // every export compiles with tsc --strict, a wrong use does not, and every
 // runtime export has a declaration.
 import { test } from 'node:test';
@@ -41,8 +41,10 @@ test('every runtime export is declared', () => {
     .matchAll(/^export (?:class|function|interface|type|const) (\w+)/gm)].map((m) => m[1]));
   const kdmeshTypes = declared('kdmesh.d.ts');
   for (const name of Object.keys(kdmesh)) assert.ok(kdmeshTypes.has(name), `kdmesh: ${name}`);
-  // kdmesh/three needs three's module graph, so its exports are read from the source.
-  const threeTypes = declared('three.d.ts');
-  for (const [, name] of readFileSync(join(root, 'web', 'three.js'), 'utf8').matchAll(/^export (?:class|function|const) (\w+)/gm))
-    assert.ok(threeTypes.has(name), `kdmesh/three: ${name}`);
+  // kdmesh/three and kdmesh/gltf need three's module graph, so their exports are read from the source.
+  for (const entry of ['three', 'gltf']) {
+    const types = declared(`${entry}.d.ts`);
+    for (const [, name] of readFileSync(join(root, 'web', `${entry}.js`), 'utf8').matchAll(/^export (?:class|function|const) (\w+)/gm))
+      assert.ok(types.has(name), `kdmesh/${entry}: ${name}`);
+  }
 });

@@ -1,4 +1,4 @@
-// Uses every export of kdmesh and kdmesh/three as a TypeScript program
+// Uses every export of kdmesh, kdmesh/three and kdmesh/gltf as a TypeScript program
 // would; tests/types/types.test.mjs compiles it with tsc --strict.
 import {
   compileWasm, createDecoder, decode, Decoder, Header, KdmeshError, memoryInUse, Model, Progress, setWasmSource, VertexAttribute,
@@ -73,4 +73,21 @@ export async function loading(renderer: WebGLRenderer): Promise<BufferGeometry> 
   const busy: number = loader.busyWorkers + (fence.passed() ? 1 : 0) + (primitive ? 1 : 0) + whole.children.length;
   loader.materials.surface.color.set(busy);
   return loader.abort().dispose() === loader ? geometry : new BufferGeometry();
+}
+
+// kdmesh/gltf: the GLTFLoader plugin, registered as three.js's own are.
+import { GLTFLoader } from 'three/examples/jsm/loaders/GLTFLoader.js';
+import { EXTENSION_NAME, KDMeshGLTFExtension, KDMeshGLTFUserData } from 'kdmesh/gltf';
+
+export async function gltfScene(url: string, bytes: Uint8Array): Promise<number> {
+  const kdmesh = new KDMeshLoader();
+  const loader = new GLTFLoader().register((parser) => new KDMeshGLTFExtension(parser, {
+    loader: kdmesh, onRefine: (geometry: BufferGeometry) => geometry.computeBoundingSphere(), limits: { maxVertices: 1e7 },
+  }));
+  const gltf = await loader.loadAsync(url);
+  const streams = gltf.userData.kdmesh as KDMeshGLTFUserData;
+  await streams.loaded;
+  const geometry = kdmesh.parseGeometry(bytes, { attributes: { NORMAL: { name: 'normal', normalized: false } } });
+  await geometry.userData.loaded;
+  return streams.streams + EXTENSION_NAME.length + gltf.scene.children.length;
 }
