@@ -260,7 +260,10 @@ int VertexSplitter::pairingSlack(const Entry& triangle) const {
 void VertexSplitter::takeMostConstrainedTriangle(size_t step) {
   size_t best = step;
   int bestSlack = pairingSlack(star_[codingOrder_[step]]);
-  for (size_t k = step + 1; k < begin_[3] && bestSlack > 0; ++k) {
+  // A bounded look-ahead: a star with thousands of paired triangles would
+  // otherwise scan them all at each step.
+  const size_t end = std::min(begin_[3], step + 1 + kPairingLookAhead);
+  for (size_t k = step + 1; k < end && bestSlack > 0; ++k) {
     const int slack = pairingSlack(star_[codingOrder_[k]]);
     if (slack < bestSlack) {
       best = k;

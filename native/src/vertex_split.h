@@ -180,6 +180,11 @@ class VertexSplitter {
   static constexpr int kUnpaired = 0x7fffffff;
   int pairingSlack(const Entry& triangle) const;
   void takeMostConstrainedTriangle(size_t step);
+  // How many triangles past the current one takeMostConstrainedTriangle()
+  // compares, so that a split's work stays linear in its star. The
+  // tetrahedral reference meshes code the same bits with this bound as
+  // without (64 changes the ball's).
+  static constexpr size_t kPairingLookAhead = 256;
   int triangleClass(const Entry& triangle) const;
   // Codes a symbol among the `possible` codes by sequential binarisation
   // (step s: is it the s-th candidate?), `codeBit(step, bit)` coding each
