@@ -129,11 +129,11 @@ class ProgressLine {
 
 // One note per kind of input simplex the encoder dropped (see InputRepairs).
 void reportRepairs(const std::string& input, const kdmesh::InputRepairs& repairs) {
-  static const char* const kNames[4] = {"points", "edges", "triangles", "tetrahedra"};
+  static const char* const kNames[4][2] = {
+      {"point", "points"}, {"edge", "edges"}, {"triangle", "triangles"}, {"tetrahedron", "tetrahedra"}};
   for (int d = 0; d < 4; ++d) {
     const auto count = [&](uint64_t value, const char* why) {
-      if (value > 0)
-        note(input + ": dropped " + std::to_string(value) + " " + kNames[d] + " " + why);
+      if (value > 0) note(input + ": dropped " + counted(value, kNames[d][0], kNames[d][1]) + " " + why);
     };
     count(repairs.degenerate[size_t(d)], "with a repeated vertex");
     count(repairs.duplicate[size_t(d)], "listed twice");
@@ -212,9 +212,9 @@ int runEncode(const EncodeArgs& args) {
     return fail(s, args.input);
   for (const std::string& n : notes) note(args.input + ": " + n);
   if (args.pointsOnly && complex.hasSimplices()) {
-    note("--points-only: dropping " + std::to_string(complex.simplexCount(1)) + " edges, " +
-         std::to_string(complex.simplexCount(2)) + " triangles, " +
-         std::to_string(complex.simplexCount(3)) + " tetrahedra");
+    note("--points-only: dropping " + counted(complex.simplexCount(1), "edge", "edges") + ", " +
+         counted(complex.simplexCount(2), "triangle", "triangles") + ", " +
+         counted(complex.simplexCount(3), "tetrahedron", "tetrahedra"));
     complex.edges.clear();
     complex.triangles.clear();
     complex.tetrahedra.clear();
@@ -328,13 +328,18 @@ int runDecode(const DecodeArgs& args) {
     const std::string dropped = keepWhatTheFormatHolds(outputFormat, complex);
     if (!dropped.empty()) note(args.output + ": left out " + dropped + " of the prefix, which " + formatName + " cannot hold");
   }
-  // Only PLY and glTF hold vertex attributes.
-  if (outputFormat != kdmesh::io::Format::Ply && outputFormat != kdmesh::io::Format::Unknown &&
-      !complex.attributes.empty()) {
+  // Attributes the output format cannot hold are left out, with a note
+  // (glTF paths, of no io::Format, keep them).
+  if (outputFormat != kdmesh::io::Format::Unknown) {
     std::string names;
-    for (const kdmesh::VertexAttribute& a : complex.attributes) names += (names.empty() ? "" : ", ") + oneLine(a.name);
-    note(args.output + ": left out the vertex attributes " + names + ", which " + formatName + " cannot hold");
-    complex.attributes.clear();
+    std::vector<kdmesh::VertexAttribute> kept;
+    for (kdmesh::VertexAttribute& a : complex.attributes) {
+      if (kdmesh::io::holdsAttribute(outputFormat, a)) kept.push_back(std::move(a));
+      else names += (names.empty() ? "" : ", ") + oneLine(a.name);
+    }
+    complex.attributes = std::move(kept);
+    if (!names.empty())
+      note(args.output + ": left out the vertex attributes " + names + ", which " + formatName + " cannot hold");
   }
   const bool gltfOutput = kdmesh::gltf::isGltfPath(args.output);
   // PLY, Medit and TetGen hold simplex labels; glTF does not.

@@ -161,7 +161,7 @@ TEST(IoStl, BinarySoupKeepsBitsEvenWhenTheHeaderStartsWithSolid) {
       expected.insert(expected.end(), t.corners.begin(), t.corners.end());
     }
     EXPECT_EQ(bitsOf(r.complex.positions), bitsOf(expected));
-    EXPECT_TRUE(r.hasNote("attribute values (often a colour) of 1 triangles")) << joined(r.notes);
+    EXPECT_TRUE(r.hasNote("attribute values (often a colour) of 1 triangle")) << joined(r.notes);
     EXPECT_TRUE(r.hasNote("facet normals of")) << joined(r.notes);
     EXPECT_EQ(r.notes.size(), 2u) << joined(r.notes);
   }
@@ -255,7 +255,7 @@ TEST(IoStl, WeldMergesBitIdenticalVerticesOnly) {
   ASSERT_TRUE(welded.status.ok()) << welded.status.message;
   EXPECT_EQ(welded.complex.vertexCount(), 5u);
   EXPECT_EQ(welded.complex.triangles, (std::vector<uint32_t>{0, 1, 2}));
-  EXPECT_TRUE(welded.hasNote("dropped 1 simplices that welding left with a repeated vertex"))
+  EXPECT_TRUE(welded.hasNote("dropped 1 simplex that welding left with a repeated vertex"))
       << joined(welded.notes);
 
   // readFile passes the option on.

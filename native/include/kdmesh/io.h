@@ -73,10 +73,28 @@ struct ReadOptions {
 //   and strips triangles, tetrahedra tetrahedra; quads and polygons are split
 //   into triangles with a note, other cell types are skipped with a note.
 //   POINT_DATA, CELL_DATA and FIELD data are ignored. Binary VTK is an error.
+// - OBJ: a corner v/vt/vn that names a texture coordinate or a normal makes
+//   a vertex of its own for each distinct (v, vt, vn) triple, with the
+//   attributes `uv` (float32 × 2, or × 3 when a vt line gives w; absent
+//   coordinates 0) and `normal` (float32 × 3): a seam's vertices share a
+//   position and keep their own values. A corner without vt or vn (v alone,
+//   or v//vn without vt) gets 0 for what it lacks; it is the v line's own
+//   vertex, shared by every such corner, as are the v lines no corner
+//   names. Points (p) may name vt and vn too, as the writer does for
+//   vertices in no face or line. vt and vn lines no corner names are
+//   counted in a note. The writer writes each distinct position, texture
+//   coordinate and normal once, and a vertex whose whole corner equals
+//   another vertex's on a v line of its own.
 Status readMemory(Format format, const uint8_t* data, size_t size,
                   Complex& out, Notes& notes, const ReadOptions& options = {});
 Status readFile(const std::string& path, Complex& out, Notes& notes,
                 const ReadOptions& options = {});
+
+// Whether files of `format` hold the vertex attribute bit for bit: PLY any;
+// OBJ `uv` (float32 × 2 or 3, as vt) and `normal` (float32 × 3, as vn).
+// Writers refuse a complex with an attribute their format cannot hold
+// (InvalidArgument) rather than drop it.
+bool holdsAttribute(Format format, const VertexAttribute& attribute);
 
 struct WriteOptions {
   // PLY only: ascii instead of binary little-endian.

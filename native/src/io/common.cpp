@@ -239,16 +239,20 @@ void PolygonSplit::append(const uint32_t* polygon, size_t size,
 
 void PolygonSplit::addNote(Notes& notes) const {
   if (polygons == 0) return;
-  notes.push_back("split " + std::to_string(polygons) +
-                  (polygons == 1 ? " polygon" : " polygons") +
+  notes.push_back("split " + counted(polygons, "polygon", "polygons") +
                   " with more than 3 vertices into " +
-                  std::to_string(triangles) + " triangles");
+                  counted(triangles, "triangle", "triangles"));
 }
 
-void addCountNote(Notes& notes, const char* before, size_t count,
-                  const char* after) {
+std::string counted(uint64_t count, std::string_view one, std::string_view many) {
+  return std::to_string(count) + " " + std::string(count == 1 ? one : many);
+}
+
+void addCountNote(Notes& notes, std::string_view before, uint64_t count,
+                  std::string_view one, std::string_view many,
+                  std::string_view after) {
   if (count == 0) return;
-  notes.push_back(before + std::to_string(count) + after);
+  notes.push_back(std::string(before) + counted(count, one, many) + std::string(after));
 }
 
 // ---------------------------------------------------------------------------

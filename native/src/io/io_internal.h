@@ -206,10 +206,14 @@ struct PolygonSplit {
   void addNote(Notes& notes) const;
 };
 
-// Adds the note `before` count `after` when count > 0, as in
-// "ignored extra columns on " 12 " vertex lines".
-void addCountNote(Notes& notes, const char* before, size_t count,
-                  const char* after);
+// "1 triangle", "2 triangles": the count and the noun it agrees with.
+std::string counted(uint64_t count, std::string_view one, std::string_view many);
+
+// Adds the note `before` counted(count, one, many) `after` when count > 0,
+// as in "ignored extra columns on " 12 " vertex line(s)" "".
+void addCountNote(Notes& notes, std::string_view before, uint64_t count,
+                  std::string_view one, std::string_view many,
+                  std::string_view after = {});
 
 // ---------------------------------------------------------------------------
 // Writing text
@@ -307,6 +311,9 @@ void weldVertices(Complex& complex, Notes& notes);
 Status writePly(const Complex& complex, std::vector<uint8_t>& out,
                 const WriteOptions& options);
 Status writeObj(const Complex& complex, std::vector<uint8_t>& out);
+// Whether OBJ holds the attribute: `uv` (float32 × 2 or 3), `normal`
+// (float32 × 3).
+bool objHoldsAttribute(const VertexAttribute& attribute);
 Status writeOff(const Complex& complex, std::vector<uint8_t>& out);
 Status writeXyz(const Complex& complex, std::vector<uint8_t>& out);
 Status writeMedit(const Complex& complex, std::vector<uint8_t>& out);

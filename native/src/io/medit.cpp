@@ -141,7 +141,7 @@ class MeditReader {
     split_.addNote(notes);
     keepLabels(notes);
     addCountNote(notes, "ignored the nonzero references of ", labelled_,
-                 " vertices");
+                 "vertex", "vertices");
     for (const std::string& skipped : skipped_) notes.push_back(skipped);
     return Status::success();
   }
@@ -209,8 +209,8 @@ class MeditReader {
     uint64_t budget = scanner_.remainingBytes() + 1;
     if (!takeFromBudget(count, 2 * section.valuesPerItem, budget)) {
       return error(std::string(section.keyword) + " declares " +
-                   std::to_string(count) +
-                   " items, more than the rest of the file can hold");
+                   counted(count, "item", "items") +
+                   ", more than the rest of the file can hold");
     }
     switch (section.kind) {
       case Kind::Vertices: return readVertices(count);

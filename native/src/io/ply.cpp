@@ -643,7 +643,7 @@ bool readIndexList(Values& values, const PlyProperty& property,
   if (length < 0 || static_cast<uint64_t>(length) < plan.listMin ||
       static_cast<uint64_t>(length) > plan.listMax) {
     return values.fail(
-        "has " + std::to_string(length) + " vertices, " +
+        "has " + counted(uint64_t(length), "vertex", "vertices") + ", " +
         (plan.listMin == plan.listMax ? "needs exactly " : "needs at least ") +
         std::to_string(plan.listMin));
   }
@@ -918,10 +918,10 @@ Status readPly(Input& input, Complex& out, Notes& notes) {
   for (int d = 1; d <= 3; ++d)
     if (!out.labels.of(d).empty()) out.labels.of(d).resize(out.simplexCount(d), 0);
   state.split.addNote(notes);
-  addCountNote(notes, "ignored ", trailingBytes,
-               " bytes after the last PLY element");
-  addCountNote(notes, "ignored ", trailingValues,
-               " values after the last PLY element");
+  addCountNote(notes, "ignored ", trailingBytes, "byte", "bytes",
+               " after the last PLY element");
+  addCountNote(notes, "ignored ", trailingValues, "value", "values",
+               " after the last PLY element");
   return Status::success();
 }
 

@@ -194,7 +194,7 @@ Status readTetgenNode(const uint8_t* data, size_t size, Complex& out,
                     " of every .node point");
   }
   addCountNote(notes, "ignored extra values on ", extraLines,
-               " .node point lines");
+               ".node point line", ".node point lines");
   return Status::success();
 }
 
@@ -298,7 +298,7 @@ Status readTetgenEle(const uint8_t* data, size_t size, uint32_t firstIndex,
                     std::to_string(attributes - 1));
   }
   addCountNote(notes, "ignored extra values on ", extraLines,
-               " .ele tetrahedron lines");
+               ".ele tetrahedron line", ".ele tetrahedron lines");
   return Status::success();
 }
 

@@ -623,7 +623,7 @@ class VtkReader {
                       " cells that are neither simplices nor polygons (VTK "
                       "cell types " + types + ")");
     }
-    addCountNote(notes, "ignored ", fields_, " FIELD data sections");
+    addCountNote(notes, "ignored ", fields_, "FIELD data section", "FIELD data sections");
   }
 
   TextScanner scanner_;
