@@ -6,7 +6,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
+#include <limits>
+#include <random>
 #include <set>
 #include <string>
 #include <vector>
@@ -22,6 +25,42 @@ inline VertexAttribute attribute(const std::string& name, AttributeType type, ui
   a.values.resize(values.size() * sizeof(T));
   std::memcpy(a.values.data(), values.data(), a.values.size());
   return a;
+}
+
+// One attribute of every type, made from the positions and a seed: smooth
+// colours, unit normals with special float values mixed in, signed labels.
+inline std::vector<VertexAttribute> everyKind(const Complex& c, uint32_t seed) {
+  std::mt19937 rng(seed);
+  const size_t n = c.vertexCount();
+  std::vector<uint8_t> colour, small;
+  std::vector<int8_t> signedByte;
+  std::vector<uint16_t> intensity;
+  std::vector<int16_t> offset;
+  std::vector<uint32_t> id;
+  std::vector<int32_t> label;
+  std::vector<float> normal, uv;
+  const float special[] = {-0.0f, std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(),
+                           std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::denorm_min(),
+                           -std::numeric_limits<float>::max()};
+  for (size_t v = 0; v < n; ++v) {
+    const float* p = &c.positions[3 * v];
+    for (int k = 0; k < 3; ++k) colour.push_back(uint8_t(int(128 + 100 * std::sin(p[k] * 2.f)) & 0xff));
+    small.push_back(uint8_t(rng() % 3));
+    signedByte.push_back(int8_t(rng() % 256));
+    intensity.push_back(uint16_t(30000 + 20000 * std::cos(p[0])));
+    offset.push_back(int16_t(int(rng() % 65536) - 32768));
+    id.push_back(uint32_t(v) * 2654435761u);
+    label.push_back(int32_t(rng() % 7) - 3);
+    const float length = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) + 1e-6f;
+    for (int k = 0; k < 3; ++k) normal.push_back(rng() % 50 == 0 ? special[rng() % 6] : p[k] / length);
+    uv.push_back(p[0] * 0.1f);
+    uv.push_back(p[1] * 0.1f);
+  }
+  return {attribute("color", AttributeType::UInt8, 3, colour),  attribute("flag", AttributeType::UInt8, 1, small),
+          attribute("tilt", AttributeType::Int8, 1, signedByte), attribute("intensity", AttributeType::UInt16, 1, intensity),
+          attribute("offset", AttributeType::Int16, 1, offset), attribute("id", AttributeType::UInt32, 1, id),
+          attribute("label", AttributeType::Int32, 1, label),   attribute("normal", AttributeType::Float32, 3, normal),
+          attribute("uv", AttributeType::Float32, 2, uv)};
 }
 
 // A vertex as its position bits followed by every attribute's bytes.

@@ -208,5 +208,88 @@ TEST(AttributeIoObj, WritesSharedCornersOnceAndRefusesOtherAttributes) {
       << refused.message;
 }
 
+// ---------------------------------------------------------------------------
+// VTK
+// ---------------------------------------------------------------------------
+
+const std::string kVtkTriangle =
+    "# vtk DataFile Version 3.0\nt\nASCII\nDATASET POLYDATA\nPOINTS 3 float\n0 0 0 1 0 0 0 1 0\n"
+    "POLYGONS 1 4\n3 0 1 2\n";
+
+TEST(AttributeIoVtk, PointDataArraysBecomeAttributes) {
+  std::string tensor;  // 9 components per point
+  for (int i = 0; i < 27; ++i) tensor += "0 ";
+  const std::string text = kVtkTriangle +
+                           "POINT_DATA 3\n"
+                           "SCALARS temperature double\n"  // no component count, no lookup table
+                           "1.5 2.5 1e300\n"
+                           "SCALARS pair short 2\nLOOKUP_TABLE default\n-1 2 -3 4 -5 32767\n"
+                           "COLOR_SCALARS rgb 3\n1 0 0.5 0 1 0 0.2 0.4 1\n"
+                           "VECTORS velocity float\n1 2 3 4 5 6 7 8 9\n"
+                           "NORMALS Normals float\n0 0 1 0 0 1 0 0 -1\n"
+                           "TEXTURE_COORDINATES TCoords 2 float\n0 0 1 0 0 1\n"
+                           "TENSORS stress float\n" + tensor + "\n" +
+                           "LOOKUP_TABLE my_table 1\n0 0 0 1\n"
+                           "GLOBAL_IDS ids vtkIdType\n0 70000 2\n"
+                           "FIELD FieldData 2\nweight 1 3 unsigned_char\n7 8 9\ntoo_long 1 4 float\n1 2 3 4\n"
+                           "CELL_DATA 1\nSCALARS region int\n5\n";
+  const ReadResult r = readText(Format::Vtk, text);
+  ASSERT_TRUE(r.status.ok()) << r.status.message;
+  std::vector<std::string> names;
+  for (const VertexAttribute& a : r.complex.attributes) names.push_back(a.name);
+  EXPECT_EQ(names, (std::vector<std::string>{"temperature", "pair", "color", "velocity", "normal", "uv", "ids",
+                                             "weight"}));
+  ASSERT_EQ(r.complex.attributes.size(), 8u);
+  const std::vector<VertexAttribute>& a = r.complex.attributes;
+  EXPECT_EQ(floats(a[0]), (std::vector<float>{1.5f, 2.5f, std::numeric_limits<float>::infinity()}));
+  EXPECT_EQ(a[1].type, AttributeType::Int16);
+  EXPECT_EQ(a[1].components, 2);
+  EXPECT_EQ(a[1].values, (std::vector<uint8_t>{0xff, 0xff, 2, 0, 0xfd, 0xff, 4, 0, 0xfb, 0xff, 0xff, 0x7f}));
+  EXPECT_EQ(a[2].type, AttributeType::UInt8);
+  EXPECT_EQ(a[2].values, (std::vector<uint8_t>{255, 0, 128, 0, 255, 0, 51, 102, 255}));
+  EXPECT_EQ(a[3].components, 3);
+  EXPECT_EQ(floats(a[4]), (std::vector<float>{0, 0, 1, 0, 0, 1, 0, 0, -1}));
+  EXPECT_EQ(a[5].components, 2);
+  EXPECT_EQ(a[6].type, AttributeType::UInt32);  // vtkIdType: the narrowest type that holds 70000
+  EXPECT_EQ(a[7].type, AttributeType::UInt8);
+  EXPECT_EQ(a[7].values, (std::vector<uint8_t>{7, 8, 9}));
+  EXPECT_TRUE(r.hasNote("rounded the values of 1 double array to float32")) << joined(r.notes);
+  // The tensor, the lookup table, the 4-tuple FIELD array and the cell data.
+  EXPECT_TRUE(r.hasNote("ignored 4 data arrays")) << joined(r.notes);
+}
+
+TEST(AttributeIoVtk, BadPointDataNamesTheLine) {
+  expectFailure(readText(Format::Vtk, kVtkTriangle + "POINT_DATA 4\n"),
+                {"line 9", "POINT_DATA gives values for 4 points, the file has 3"});
+  expectFailure(readText(Format::Vtk, kVtkTriangle + "POINT_DATA 3\nSCALARS s unsigned_char\n1 2 256\n"),
+                {"line 11", "SCALARS 's' value 2: '256' is not a unsigned_char value"});
+  expectFailure(readText(Format::Vtk, kVtkTriangle + "POINT_DATA 3\nCOLOR_SCALARS c 1\n0 1 1.5\n"),
+                {"'1.5' is not a number from 0 to 1"});
+  expectFailure(readText(Format::Vtk, kVtkTriangle + "POINT_DATA 3\nVECTORS v float\n1 2 3 4" + std::string(20, ' ')),
+                {"the file ends inside VECTORS 'v'"});
+  expectFailure(readText(Format::Vtk, kVtkTriangle + "POINT_DATA 3\nSCALARS s float 4000000000\n1\n"),
+                {"more than the rest of the file can hold"});
+  expectFailure(readText(Format::Vtk, kVtkTriangle + "POINT_DATA 3\nNORMALS n quaternion\n"),
+                {"unknown data type 'quaternion'"});
+}
+
+TEST(AttributeIoVtk, EveryTypeRoundTripsExactly) {
+  for (Complex c : {torusMesh(5, 8), tetrahedralBlock(3, 4), pointCloud({0, 0, 0, 1, 1, 1, 1, 1, 1})}) {
+    c.attributes = everyKind(c, 3);
+    expectFileRoundTrip(Format::Vtk, c);
+  }
+  // Colours of uint8 go through COLOR_SCALARS; of other types, SCALARS.
+  Complex c = torusMesh(3, 4);
+  std::vector<uint8_t> rgba;
+  for (size_t i = 0; i < 4 * c.vertexCount(); ++i) rgba.push_back(uint8_t(i * 37));
+  c.attributes = {attribute("color", AttributeType::UInt8, 4, rgba)};
+  std::vector<uint8_t> bytes;
+  ASSERT_TRUE(io::writeMemory(Format::Vtk, c, bytes).ok());
+  EXPECT_NE(std::string(bytes.begin(), bytes.end()).find("COLOR_SCALARS color 4\n"), std::string::npos);
+  expectFileRoundTrip(Format::Vtk, c);
+  c.attributes = {attribute("two words", AttributeType::UInt8, 4, rgba)};
+  EXPECT_EQ(io::writeMemory(Format::Vtk, c, bytes).code, ErrorCode::InvalidArgument);
+}
+
 }  // namespace
 }  // namespace kdmesh::test

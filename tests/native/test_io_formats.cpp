@@ -680,7 +680,10 @@ TEST(IoVtk, ReadsUnstructuredGridWithEveryCellKindCrlfAndIgnoredData) {
       "POINT_DATA 6\n"
       "SCALARS s float 1\n"
       "LOOKUP_TABLE default\n"
-      "1 2 3 4 5 6\n";
+      "1 2 3 4 5 6\n"
+      "CELL_DATA 10\n"
+      "SCALARS region int\n"
+      "1 1 1 1 1 1 1 1 1 2\n";
   for (const std::string& variant : {text, crlf(text)}) {
     const ReadResult r = readText(Format::Vtk, variant);
     ASSERT_TRUE(r.status.ok()) << r.status.message;
@@ -695,9 +698,13 @@ TEST(IoVtk, ReadsUnstructuredGridWithEveryCellKindCrlfAndIgnoredData) {
                                      5, 4, 3, 0, 2, 4, 0, 4, 5}));
     EXPECT_EQ(r.complex.tetrahedra, (std::vector<uint32_t>{0, 1, 2, 3}));
     EXPECT_TRUE(r.hasNote("split 3 polygons")) << joined(r.notes);
-    EXPECT_TRUE(r.hasNote("skipped 1 cells")) << joined(r.notes);
+    EXPECT_TRUE(r.hasNote("skipped 1 cell that is")) << joined(r.notes);
     EXPECT_TRUE(r.hasNote("types 12 x1")) << joined(r.notes);
-    EXPECT_TRUE(r.hasNote("ignored POINT_DATA")) << joined(r.notes);
+    ASSERT_EQ(r.complex.attributes.size(), 1u);
+    EXPECT_EQ(r.complex.attributes[0].name, "s");
+    EXPECT_EQ(r.complex.attributes[0].type, AttributeType::Float32);
+    EXPECT_EQ(r.complex.attributes[0].values.size(), 24u);
+    EXPECT_TRUE(r.hasNote("ignored 1 data array (cell data")) << joined(r.notes);
     EXPECT_TRUE(r.hasNote("double")) << joined(r.notes);
     EXPECT_TRUE(r.hasNote("ignored 1 FIELD")) << joined(r.notes);
   }
@@ -751,7 +758,7 @@ TEST(IoVtk, ReadsVersion5OffsetsAndPolyData) {
   EXPECT_EQ(r.complex.tetrahedra, (std::vector<uint32_t>{0, 1, 2, 3}));
   EXPECT_EQ(r.complex.triangles, (std::vector<uint32_t>{3, 2, 1}));
   EXPECT_EQ(r.complex.edges, (std::vector<uint32_t>{0, 3}));
-  EXPECT_TRUE(r.hasNote("ignored CELL_DATA")) << joined(r.notes);
+  EXPECT_TRUE(r.complex.attributes.empty());
 
   const std::string polyData =
       "# vtk DataFile Version 3.0\n"

@@ -72,7 +72,17 @@ struct ReadOptions {
 //   poly-vertex cells become points, lines and poly-lines edges, triangles
 //   and strips triangles, tetrahedra tetrahedra; quads and polygons are split
 //   into triangles with a note, other cell types are skipped with a note.
-//   POINT_DATA, CELL_DATA and FIELD data are ignored. Binary VTK is an error.
+//   POINT_DATA arrays of 1 to 4 components become vertex attributes named
+//   as in the file, of the file's type (integers of up to 32 bits as such;
+//   float and double as float32, double rounded with a note; 64-bit
+//   integers as the narrowest type that holds their values), except NORMALS
+//   as `normal`, TEXTURE_COORDINATES as `uv` and COLOR_SCALARS as `color`,
+//   uint8 = 255 x value rounded, as VTK stores them. SCALARS, VECTORS,
+//   GLOBAL_IDS, PEDIGREE_IDS and FIELD arrays of one tuple per point are
+//   read; TENSORS, lookup tables, CELL_DATA and the dataset's FIELD data are
+//   skipped and counted in a note. The writer gives `normal`, `uv` and a
+//   uint8 `color` their keywords, every other attribute SCALARS of its type.
+//   Binary VTK is an error.
 // - OBJ: a corner v/vt/vn that names a texture coordinate or a normal makes
 //   a vertex of its own for each distinct (v, vt, vn) triple, with the
 //   attributes `uv` (float32 × 2, or × 3 when a vt line gives w; absent
@@ -91,7 +101,8 @@ Status readFile(const std::string& path, Complex& out, Notes& notes,
                 const ReadOptions& options = {});
 
 // Whether files of `format` hold the vertex attribute bit for bit: PLY any;
-// OBJ `uv` (float32 × 2 or 3, as vt) and `normal` (float32 × 3, as vn).
+// OBJ `uv` (float32 × 2 or 3, as vt) and `normal` (float32 × 3, as vn); VTK
+// any whose name has no space. (Text keeps a NaN's sign, not its payload.)
 // Writers refuse a complex with an attribute their format cannot hold
 // (InvalidArgument) rather than drop it.
 bool holdsAttribute(Format format, const VertexAttribute& attribute);

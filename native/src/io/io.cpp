@@ -299,6 +299,7 @@ bool holdsAttribute(Format format, const VertexAttribute& a) {
   switch (format) {
     case Format::Ply: return true;
     case Format::Obj: return detail::objHoldsAttribute(a);
+    case Format::Vtk: return detail::vtkHoldsAttribute(a);
     default: return false;
   }
 }

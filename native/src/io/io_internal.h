@@ -192,6 +192,25 @@ Status lineError(size_t line, const std::string& message);
 bool takeFromBudget(uint64_t count, uint64_t minBytesEach, uint64_t& budget);
 
 // ---------------------------------------------------------------------------
+// Attribute values in text (VTK, TetGen, Medit)
+// ---------------------------------------------------------------------------
+
+// Parses `token` as one value of `type` into `out` (its bytes in memory
+// order): an integer must be whole and fit the type; a float is rounded to
+// float32 (NaN and infinities included).
+bool parseAttributeValue(std::string_view token, AttributeType type, uint8_t* out);
+
+// The narrowest integer type that holds every one of `values`, unsigned
+// before signed (uint8, int8, uint16, ...); false when no 32-bit type does.
+bool narrowestIntegerType(const std::vector<int64_t>& values, AttributeType& type);
+
+// A one-component attribute of `type` with `values`, which fit it.
+VertexAttribute integerAttribute(std::string name, AttributeType type, const std::vector<int64_t>& values);
+
+// The attribute of `complex` named `name`, or nullptr.
+const VertexAttribute* findAttribute(const Complex& complex, std::string_view name);
+
+// ---------------------------------------------------------------------------
 // Polygons
 // ---------------------------------------------------------------------------
 
@@ -230,6 +249,9 @@ class TextOut {
   // The three coordinates at `xyz`.
   TextOut& point(const float* xyz) { return real(xyz[0]).real(xyz[1]).real(xyz[2]); }
   TextOut& integer(uint64_t value);
+  TextOut& signedInteger(int64_t value);
+  // One attribute value of `type`, from its bytes in memory order.
+  TextOut& value(AttributeType type, const uint8_t* bytes);
   TextOut& endLine();
 
  private:
@@ -318,6 +340,8 @@ Status writeOff(const Complex& complex, std::vector<uint8_t>& out);
 Status writeXyz(const Complex& complex, std::vector<uint8_t>& out);
 Status writeMedit(const Complex& complex, std::vector<uint8_t>& out);
 Status writeVtk(const Complex& complex, std::vector<uint8_t>& out);
+// Whether VTK holds the attribute: any whose name has no space.
+bool vtkHoldsAttribute(const VertexAttribute& attribute);
 // The .node file, after checking that the complex has nothing but vertices
 // and tetrahedra; the .ele file (which may list no tetrahedra).
 Status writeTetgenNode(const Complex& complex, std::vector<uint8_t>& out);

@@ -309,14 +309,6 @@ Status readObj(const uint8_t* data, size_t size, Complex& out, Notes& notes) {
 
 namespace {
 
-// The attributes an OBJ file holds: `uv` (float32 × 2 or 3) and `normal`
-// (float32 × 3).
-const VertexAttribute* findObjAttribute(const Complex& complex, const char* name) {
-  for (const VertexAttribute& a : complex.attributes)
-    if (a.name == name) return &a;
-  return nullptr;
-}
-
 // Numbers the distinct values of `count` records of `bytes` bytes, in order
 // of first appearance; returns each record's number, and appends to `firsts`
 // the record that first had each.
@@ -348,8 +340,8 @@ Status writeObj(const Complex& complex, std::vector<uint8_t>& out) {
   TextOut text(out);
   text.word("# written by kdmesh").endLine();
   const size_t n = complex.vertexCount();
-  const VertexAttribute* uv = findObjAttribute(complex, "uv");
-  const VertexAttribute* normal = findObjAttribute(complex, "normal");
+  const VertexAttribute* uv = findAttribute(complex, "uv");
+  const VertexAttribute* normal = findAttribute(complex, "normal");
   // Corner (v, vt, vn) of each vertex, numbered from 0; without attributes
   // vertex i is line v i.
   std::vector<uint32_t> position(n), uvOf, normalOf;

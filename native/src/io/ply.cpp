@@ -993,22 +993,7 @@ class TextSink {
  public:
   explicit TextSink(std::vector<uint8_t>& out) : text_(out) {}
   void coordinate(float value) { text_.real(value); }
-  void attribute(AttributeType type, const uint8_t* value) {
-    uint32_t bits = 0;
-    std::memcpy(&bits, value, attributeTypeBytes(type));
-    switch (type) {
-      case AttributeType::Float32: {
-        float f;
-        std::memcpy(&f, &bits, 4);
-        text_.real(f);
-        break;
-      }
-      case AttributeType::Int8: text_.word(std::to_string(int8_t(bits))); break;
-      case AttributeType::Int16: text_.word(std::to_string(int16_t(bits))); break;
-      case AttributeType::Int32: text_.word(std::to_string(int32_t(bits))); break;
-      default: text_.integer(bits); break;
-    }
-  }
+  void attribute(AttributeType type, const uint8_t* value) { text_.value(type, value); }
   void listLength(uint8_t length) { text_.integer(length); }
   void index(uint32_t value) { text_.integer(value); }
   void label(int32_t value) { text_.word(std::to_string(value)); }
