@@ -13,6 +13,7 @@
 #include "attribute_support.h"
 #include "complexes.h"
 #include "io_test_support.h"
+#include "io/io_internal.h"
 #include "kdmesh/io.h"
 #include "test_support.h"
 
@@ -289,6 +290,62 @@ TEST(AttributeIoVtk, EveryTypeRoundTripsExactly) {
   expectFileRoundTrip(Format::Vtk, c);
   c.attributes = {attribute("two words", AttributeType::UInt8, 4, rgba)};
   EXPECT_EQ(io::writeMemory(Format::Vtk, c, bytes).code, ErrorCode::InvalidArgument);
+}
+
+// ---------------------------------------------------------------------------
+// TetGen and Medit
+// ---------------------------------------------------------------------------
+
+TEST(AttributeIoTetgen, AttributesAndMarkersRoundTripWithTheNarrowestMarkerType) {
+  TempDir dir;
+  writeWhole(dir / "m.node",
+             "3 3 6 1\n1 0 0 0 1 2 3 4 5 6 -1\n2 1 0 0 1 2 3 4 5 6 300\n3 0 1 0 nan 2 3 4 5 -0 0\n");
+  const ReadResult r = readPath(dir / "m.node");
+  ASSERT_TRUE(r.status.ok()) << r.status.message;
+  ASSERT_EQ(r.complex.attributes.size(), 3u);
+  // More than 4 attributes: groups of up to 4, named by their first column.
+  EXPECT_EQ(r.complex.attributes[0].name, "attribute_0");
+  EXPECT_EQ(r.complex.attributes[0].components, 4);
+  EXPECT_EQ(r.complex.attributes[1].name, "attribute_4");
+  EXPECT_EQ(r.complex.attributes[1].components, 2);
+  EXPECT_EQ(r.complex.attributes[2].name, "marker");
+  EXPECT_EQ(r.complex.attributes[2].type, AttributeType::Int16);  // -1 and 300
+  expectFailure(readText(Format::TetGen, "2 3 1 1\n1 0 0 0 5 1\n2 1 0 0 5\n"),
+                {"line 3", "point 1 lacks 1 of the attribute or marker values"});
+  expectFailure(readText(Format::TetGen, "1 3 1 1\n1 0 0 0 5 x\n"), {"line 2", "'x' is not an integer boundary marker"});
+  expectFailure(readText(Format::TetGen, "1 3 1 0\n1 0 0 0 y\n"), {"line 2", "'y' is not a number"});
+
+  Complex block = tetrahedralBlock(3, 5);
+  std::vector<float> values;
+  std::vector<uint16_t> markers;
+  for (size_t v = 0; v < block.vertexCount(); ++v) {
+    values.insert(values.end(), {block.positions[3 * v] * 0.3f, float(v) * -1e-3f, 1e30f});
+    markers.push_back(uint16_t(v * 997 % 40000));
+  }
+  block.attributes = {attribute("attribute", AttributeType::Float32, 3, values),
+                      attribute("marker", AttributeType::UInt16, 1, markers)};
+  ASSERT_TRUE(io::writeFile((dir / "block.node").string(), block).ok());
+  const ReadResult back = readPath(dir / "block.node");
+  ASSERT_TRUE(back.status.ok()) << back.status.message;
+  expectSameDescriptors(block, back.complex);
+  EXPECT_TRUE(keyedForm(back.complex) == keyedForm(block));
+  block.attributes.push_back(attribute("other", AttributeType::UInt8, 1, std::vector<uint8_t>(block.vertexCount())));
+  EXPECT_EQ(io::writeFile((dir / "block.node").string(), block).code, ErrorCode::InvalidArgument);
+}
+
+TEST(AttributeIoMedit, VertexReferencesRoundTrip) {
+  for (const int64_t largest : {int64_t{200}, int64_t{-5}, int64_t{70000}, int64_t{3000000000}}) {
+    Complex block = tetrahedralBlock(3, 6);
+    std::vector<int64_t> references(block.vertexCount(), 0);
+    references[1] = largest;
+    references[2] = 1;
+    AttributeType type;
+    ASSERT_TRUE(io::detail::narrowestIntegerType(references, type));
+    block.attributes = {io::detail::integerAttribute("ref", type, references)};
+    expectFileRoundTrip(Format::Medit, block);
+  }
+  expectFailure(readText(Format::Medit, "MeshVersionFormatted 1\nDimension 3\nVertices\n1\n0 0 0 5000000000\n"),
+                {"vertex references beyond the 32-bit range"});
 }
 
 }  // namespace

@@ -403,8 +403,12 @@ TEST(IoMedit, ReadsCommentsCrlfWrappedValuesQuadsAndSkippedSections) {
     EXPECT_TRUE(r.hasNote("split 1 polygon with")) << joined(r.notes);
     EXPECT_TRUE(r.hasNote("skipped 2 Corners")) << joined(r.notes);
     EXPECT_TRUE(r.hasNote("skipped 1 Hexahedra")) << joined(r.notes);
-    EXPECT_TRUE(r.hasNote("nonzero references of 2 vertices")) << joined(r.notes);
-    // Element references are the simplices' labels.
+    // Vertex references are the attribute ref; element references the
+    // simplices' labels.
+    ASSERT_EQ(r.complex.attributes.size(), 1u);
+    EXPECT_EQ(r.complex.attributes[0].name, "ref");
+    EXPECT_EQ(r.complex.attributes[0].type, AttributeType::UInt8);
+    EXPECT_EQ(r.complex.attributes[0].values, (std::vector<uint8_t>{1, 0, 0, 0, 7}));
     EXPECT_EQ(r.complex.labels.edges, (std::vector<int32_t>{0}));
     EXPECT_EQ(r.complex.labels.triangles, (std::vector<int32_t>{3, 3, 0}));
     EXPECT_EQ(r.complex.labels.tetrahedra, (std::vector<int32_t>{2}));
@@ -527,7 +531,14 @@ TEST(IoTetgen, ReadsHandWrittenFilesNumberedFromZeroOrOne) {
   EXPECT_EQ(bitsOf(zero.complex.positions),
             bitsOf(std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0.1f, 0.2f, 0.3f}));
   EXPECT_EQ(zero.complex.tetrahedra, (std::vector<uint32_t>{0, 1, 2, 3, 4, 3, 2, 1}));
-  EXPECT_TRUE(zero.hasNote("2 attributes and the boundary marker")) << joined(zero.notes);
+  // The point attributes and the boundary markers are attributes.
+  ASSERT_EQ(zero.complex.attributes.size(), 2u);
+  EXPECT_EQ(zero.complex.attributes[0].name, "attribute");
+  EXPECT_EQ(zero.complex.attributes[0].components, 2);
+  EXPECT_EQ(zero.complex.attributes[0].values.size(), 40u);
+  EXPECT_EQ(zero.complex.attributes[1].name, "marker");
+  EXPECT_EQ(zero.complex.attributes[1].type, AttributeType::UInt8);
+  EXPECT_EQ(zero.complex.attributes[1].values, (std::vector<uint8_t>{1, 0, 0, 0, 0}));
   EXPECT_EQ(zero.complex.labels.tetrahedra, (std::vector<int32_t>{-1, -1}));  // the region attribute
 
   // Numbered from 1, header without attribute counts, 10-node tetrahedra.

@@ -61,11 +61,18 @@ struct ReadOptions {
 // - Medit: Dimension 3 only. Quadrilaterals are split into two triangles
 //   (a note says how many); Hexahedra, Prisms, Pyramids, P2/Q2 elements and
 //   known per-item sections (Corners, Ridges, Required*, Normals, ...) are
-//   skipped with a note; any other keyword is an error naming it. References
-//   are ignored.
+//   skipped with a note; any other keyword is an error naming it. Vertex
+//   references become the attribute `ref` (unless all are 0), of the
+//   narrowest integer type that holds them (uint8, int8, uint16, ...);
+//   element references are counted in a note. The writer writes `ref`.
 // - TetGen: readFile on x.node or x.ele reads both files (x.ele is optional
 //   when x.node is given: without it the nodes are a point cloud). Point
 //   numbers may start at 0 or 1; 10-node tetrahedra keep their 4 corners.
+//   The .node point attributes become the attribute `attribute` (float32,
+//   up to 4 components; more are grouped by 4 as `attribute_0`,
+//   `attribute_4`, ...) and the boundary markers `marker`, of the narrowest
+//   integer type that holds them; the writer writes both back. Region
+//   attributes of the .ele are counted in a note.
 //   readMemory can read one buffer only, so it reads a .node alone.
 // - VTK: legacy ascii UNSTRUCTURED_GRID or POLYDATA, cells in the classic
 //   layout or the OFFSETS/CONNECTIVITY layout of version 5. Vertex and
@@ -102,7 +109,9 @@ Status readFile(const std::string& path, Complex& out, Notes& notes,
 
 // Whether files of `format` hold the vertex attribute bit for bit: PLY any;
 // OBJ `uv` (float32 × 2 or 3, as vt) and `normal` (float32 × 3, as vn); VTK
-// any whose name has no space. (Text keeps a NaN's sign, not its payload.)
+// any whose name has no space; Medit `ref` and TetGen `marker` (integers, 1
+// component; read back as the narrowest type that holds their values) and
+// TetGen `attribute` (float32). (Text keeps a NaN's sign, not its payload.)
 // Writers refuse a complex with an attribute their format cannot hold
 // (InvalidArgument) rather than drop it.
 bool holdsAttribute(Format format, const VertexAttribute& attribute);

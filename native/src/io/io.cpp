@@ -300,6 +300,8 @@ bool holdsAttribute(Format format, const VertexAttribute& a) {
     case Format::Ply: return true;
     case Format::Obj: return detail::objHoldsAttribute(a);
     case Format::Vtk: return detail::vtkHoldsAttribute(a);
+    case Format::Medit: return detail::meditHoldsAttribute(a);
+    case Format::TetGen: return detail::tetgenHoldsAttribute(a);
     default: return false;
   }
 }

@@ -339,6 +339,8 @@ bool objHoldsAttribute(const VertexAttribute& attribute);
 Status writeOff(const Complex& complex, std::vector<uint8_t>& out);
 Status writeXyz(const Complex& complex, std::vector<uint8_t>& out);
 Status writeMedit(const Complex& complex, std::vector<uint8_t>& out);
+// Whether Medit holds the attribute: `ref`, an integer per vertex.
+bool meditHoldsAttribute(const VertexAttribute& attribute);
 Status writeVtk(const Complex& complex, std::vector<uint8_t>& out);
 // Whether VTK holds the attribute: any whose name has no space.
 bool vtkHoldsAttribute(const VertexAttribute& attribute);
@@ -346,6 +348,10 @@ bool vtkHoldsAttribute(const VertexAttribute& attribute);
 // and tetrahedra; the .ele file (which may list no tetrahedra).
 Status writeTetgenNode(const Complex& complex, std::vector<uint8_t>& out);
 Status writeTetgenEle(const Complex& complex, std::vector<uint8_t>& out);
+// Whether TetGen holds the attribute: `attribute` (float32 × 1..4, the
+// point attributes) and `marker` (an integer per vertex, the boundary
+// marker).
+bool tetgenHoldsAttribute(const VertexAttribute& attribute);
 
 // True when every listed point is a vertex used by no simplex, so a format
 // without explicit points loses nothing by dropping the list: such vertices
