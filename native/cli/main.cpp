@@ -156,6 +156,8 @@ struct EncodeArgs {
   bool bitsGiven = false;  // --bits on the command line: glTF positions go to the grid
   bool fallback = false;
   bool kdmFiles = false;
+  int attributeBits = 0;
+  int normalBits = 0;
 };
 
 // Three quarters of the machine's physical memory, or 0 (no limit) where
@@ -226,6 +228,8 @@ int runEncode(const EncodeArgs& args) {
   options.exact = args.exact;
   options.chunkBytes = args.chunkBytes;
   options.maxMemoryBytes = args.maxMemory == EncodeArgs::kMachineMemory ? defaultMemoryLimit() : args.maxMemory;
+  options.attributeBits = args.attributeBits;
+  options.normalBits = args.normalBits;
   ProgressLine progress;
   options.progress = [&](const kdmesh::EncodeProgress& p) { progress.update(p.phase, p.fraction); };
   const auto encodeStart = Clock::now();
@@ -375,6 +379,14 @@ std::string jsonEscaped(const std::string& text) {
   return out;
 }
 
+const char* codingName(const kdmesh::AttributeQuantization& q) {
+  switch (q.kind) {
+    case kdmesh::AttributeQuantization::Uniform: return "uniform";
+    case kdmesh::AttributeQuantization::Octahedral: return "octahedral";
+    default: return "exact";
+  }
+}
+
 // JSON has no inf or nan: those (from an empty model) print as null.
 std::string jsonNumber(double v) {
   if (!std::isfinite(v)) return "null";
@@ -423,9 +435,11 @@ int runInfo(const std::string& input, bool json, bool perLevel) {
                 jsonNumber(cost.labelBits / n).c_str());
     std::printf("  \"attributes\": [");
     for (size_t a = 0; a < final.attributes.size(); ++a)
-      std::printf("%s{\"name\": \"%s\", \"type\": \"%s\", \"components\": %u, \"bitsPerVertex\": %s}",
+      std::printf("%s{\"name\": \"%s\", \"type\": \"%s\", \"components\": %u, \"coding\": \"%s\", "
+                  "\"codingBits\": %u, \"bitsPerVertex\": %s}",
                   a ? ", " : "", jsonEscaped(final.attributes[a].name).c_str(),
                   kdmesh::attributeTypeName(final.attributes[a].type), unsigned(final.attributes[a].components),
+                  codingName(final.attributes[a].quantization), unsigned(final.attributes[a].quantization.bits),
                   jsonNumber(cost.attributeBits[a] / n).c_str());
     std::printf("],\n");
     std::printf("  \"bitsPerVertex\": {\"total\": %s, \"geometry\": %s, \"connectivity\": %s},\n",
@@ -489,9 +503,13 @@ int runInfo(const std::string& input, bool json, bool perLevel) {
                 cost.labelBits / n, simplices ? cost.labelBits / double(simplices) : 0.0);
   }
   for (size_t a = 0; a < final.attributes.size(); ++a)
-    std::printf("%s%s (%u %s) %.3f bits/vertex\n", a == 0 ? "attributes      " : "                ",
+    std::printf("%s%s (%u %s, %s%s) %.3f bits/vertex\n", a == 0 ? "attributes      " : "                ",
                 oneLine(final.attributes[a].name).c_str(), unsigned(final.attributes[a].components),
-                kdmesh::attributeTypeName(final.attributes[a].type), cost.attributeBits[a] / n);
+                kdmesh::attributeTypeName(final.attributes[a].type), codingName(final.attributes[a].quantization),
+                final.attributes[a].quantization.bits
+                    ? (" " + std::to_string(final.attributes[a].quantization.bits) + " bits").c_str()
+                    : "",
+                cost.attributeBits[a] / n);
   if (h.maxDimension > 0) {
     // As the paper's Table 1: which operator undid each of the n - 1 merges.
     std::printf("operators       %" PRIu64 " vertex splits (%.1f %% of %u merges), of which %" PRIu64
@@ -578,6 +596,14 @@ int main(int argc, char** argv) {
                      "Largest chunk payload in bytes; the first chunks start at 1 KiB")
       ->check(CLI::Range(64, 1 << 26))
       ->capture_default_str();
+  encode->add_option("--attr-bits", encodeArgs.attributeBits,
+                     "Quantize float32 vertex attributes to N bits per component over each one's range "
+                     "(1-24; lossy; default: exact)")
+      ->check(CLI::Range(1, 24));
+  encode->add_option("--normal-bits", encodeArgs.normalBits,
+                     "Code the float32 x 3 attribute 'normal' as unit vectors in two N-bit octahedral "
+                     "coordinates (2-16; lossy; default: exact, or --attr-bits)")
+      ->check(CLI::Range(2, 16));
   encode->add_flag("--points-only", encodeArgs.pointsOnly,
                    "Drop edges, triangles and tetrahedra and encode the vertices");
   encode->add_flag("--weld", encodeArgs.weld,

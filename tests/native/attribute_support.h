@@ -21,7 +21,7 @@ namespace kdmesh::test {
 
 template <class T>
 inline VertexAttribute attribute(const std::string& name, AttributeType type, uint8_t components, const std::vector<T>& values) {
-  VertexAttribute a{name, type, components, {}};
+  VertexAttribute a{name, type, components, {}, {}};
   a.values.resize(values.size() * sizeof(T));
   std::memcpy(a.values.data(), values.data(), a.values.size());
   return a;

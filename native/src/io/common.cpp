@@ -274,7 +274,7 @@ bool narrowestIntegerType(const std::vector<int64_t>& values, AttributeType& typ
 }
 
 VertexAttribute integerAttribute(std::string name, AttributeType type, const std::vector<int64_t>& values) {
-  VertexAttribute a{std::move(name), type, 1, {}};
+  VertexAttribute a{std::move(name), type, 1, {}, {}};
   const size_t bytes = attributeTypeBytes(type);
   a.values.resize(values.size() * bytes);
   for (size_t i = 0; i < values.size(); ++i) {

@@ -185,7 +185,7 @@ Status readValues(TextScanner& scanner, const char* keyword, size_t least, std::
 }
 
 VertexAttribute floatAttribute(const char* name, int components, size_t vertices) {
-  VertexAttribute a{name, AttributeType::Float32, uint8_t(components), {}};
+  VertexAttribute a{name, AttributeType::Float32, uint8_t(components), {}, {}};
   a.values.assign(vertices * a.valueBytes(), 0);
   return a;
 }

@@ -161,7 +161,7 @@ Status readTetgenNode(const uint8_t* data, size_t size, Complex& out,
   std::vector<VertexAttribute> pointAttributes;
   for (uint64_t first = 0; first < kept; first += 4) {
     VertexAttribute a{kept <= 4 ? "attribute" : "attribute_" + std::to_string(first), AttributeType::Float32,
-                      uint8_t(std::min<uint64_t>(4, kept - first)), {}};
+                      uint8_t(std::min<uint64_t>(4, kept - first)), {}, {}};
     a.values.reserve(count * a.valueBytes());
     pointAttributes.push_back(std::move(a));
   }

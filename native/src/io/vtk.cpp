@@ -359,7 +359,7 @@ class VtkReader {
         if (!tokens_.next(token)) return error("the file ends inside " + keyword);
       return Status::success();
     }
-    VertexAttribute a{name, type, uint8_t(components), {}};
+    VertexAttribute a{name, type, uint8_t(components), {}, {}};
     std::vector<int64_t> integers;  // 64-bit values, typed when all are read
     a.values.resize(wide ? 0 : size_t(count) * attributeTypeBytes(type));
     std::string_view token;
