@@ -129,11 +129,11 @@ class ProgressLine {
 
 // One note per kind of input simplex the encoder dropped (see InputRepairs).
 void reportRepairs(const std::string& input, const kdmesh::InputRepairs& repairs) {
-  static const char* const kNames[4] = {"points", "edges", "triangles", "tetrahedra"};
+  static const char* const kNames[4][2] = {
+      {"point", "points"}, {"edge", "edges"}, {"triangle", "triangles"}, {"tetrahedron", "tetrahedra"}};
   for (int d = 0; d < 4; ++d) {
     const auto count = [&](uint64_t value, const char* why) {
-      if (value > 0)
-        note(input + ": dropped " + std::to_string(value) + " " + kNames[d] + " " + why);
+      if (value > 0) note(input + ": dropped " + counted(value, kNames[d][0], kNames[d][1]) + " " + why);
     };
     count(repairs.degenerate[size_t(d)], "with a repeated vertex");
     count(repairs.duplicate[size_t(d)], "listed twice");
@@ -156,6 +156,8 @@ struct EncodeArgs {
   bool bitsGiven = false;  // --bits on the command line: glTF positions go to the grid
   bool fallback = false;
   bool kdmFiles = false;
+  int attributeBits = 0;
+  int normalBits = 0;
 };
 
 // Three quarters of the machine's physical memory, or 0 (no limit) where
@@ -212,9 +214,9 @@ int runEncode(const EncodeArgs& args) {
     return fail(s, args.input);
   for (const std::string& n : notes) note(args.input + ": " + n);
   if (args.pointsOnly && complex.hasSimplices()) {
-    note("--points-only: dropping " + std::to_string(complex.simplexCount(1)) + " edges, " +
-         std::to_string(complex.simplexCount(2)) + " triangles, " +
-         std::to_string(complex.simplexCount(3)) + " tetrahedra");
+    note("--points-only: dropping " + counted(complex.simplexCount(1), "edge", "edges") + ", " +
+         counted(complex.simplexCount(2), "triangle", "triangles") + ", " +
+         counted(complex.simplexCount(3), "tetrahedron", "tetrahedra"));
     complex.edges.clear();
     complex.triangles.clear();
     complex.tetrahedra.clear();
@@ -226,6 +228,8 @@ int runEncode(const EncodeArgs& args) {
   options.exact = args.exact;
   options.chunkBytes = args.chunkBytes;
   options.maxMemoryBytes = args.maxMemory == EncodeArgs::kMachineMemory ? defaultMemoryLimit() : args.maxMemory;
+  options.attributeBits = args.attributeBits;
+  options.normalBits = args.normalBits;
   ProgressLine progress;
   options.progress = [&](const kdmesh::EncodeProgress& p) { progress.update(p.phase, p.fraction); };
   const auto encodeStart = Clock::now();
@@ -328,13 +332,18 @@ int runDecode(const DecodeArgs& args) {
     const std::string dropped = keepWhatTheFormatHolds(outputFormat, complex);
     if (!dropped.empty()) note(args.output + ": left out " + dropped + " of the prefix, which " + formatName + " cannot hold");
   }
-  // Only PLY and glTF hold vertex attributes.
-  if (outputFormat != kdmesh::io::Format::Ply && outputFormat != kdmesh::io::Format::Unknown &&
-      !complex.attributes.empty()) {
+  // Attributes the output format cannot hold are left out, with a note
+  // (glTF paths, of no io::Format, keep them).
+  if (outputFormat != kdmesh::io::Format::Unknown) {
     std::string names;
-    for (const kdmesh::VertexAttribute& a : complex.attributes) names += (names.empty() ? "" : ", ") + oneLine(a.name);
-    note(args.output + ": left out the vertex attributes " + names + ", which " + formatName + " cannot hold");
-    complex.attributes.clear();
+    std::vector<kdmesh::VertexAttribute> kept;
+    for (kdmesh::VertexAttribute& a : complex.attributes) {
+      if (kdmesh::io::holdsAttribute(outputFormat, a)) kept.push_back(std::move(a));
+      else names += (names.empty() ? "" : ", ") + oneLine(a.name);
+    }
+    complex.attributes = std::move(kept);
+    if (!names.empty())
+      note(args.output + ": left out the vertex attributes " + names + ", which " + formatName + " cannot hold");
   }
   const bool gltfOutput = kdmesh::gltf::isGltfPath(args.output);
   // PLY, Medit and TetGen hold simplex labels; glTF does not.
@@ -368,6 +377,14 @@ std::string jsonEscaped(const std::string& text) {
     out += c;
   }
   return out;
+}
+
+const char* codingName(const kdmesh::AttributeQuantization& q) {
+  switch (q.kind) {
+    case kdmesh::AttributeQuantization::Uniform: return "uniform";
+    case kdmesh::AttributeQuantization::Octahedral: return "octahedral";
+    default: return "exact";
+  }
 }
 
 // JSON has no inf or nan: those (from an empty model) print as null.
@@ -418,9 +435,11 @@ int runInfo(const std::string& input, bool json, bool perLevel) {
                 jsonNumber(cost.labelBits / n).c_str());
     std::printf("  \"attributes\": [");
     for (size_t a = 0; a < final.attributes.size(); ++a)
-      std::printf("%s{\"name\": \"%s\", \"type\": \"%s\", \"components\": %u, \"bitsPerVertex\": %s}",
+      std::printf("%s{\"name\": \"%s\", \"type\": \"%s\", \"components\": %u, \"coding\": \"%s\", "
+                  "\"codingBits\": %u, \"bitsPerVertex\": %s}",
                   a ? ", " : "", jsonEscaped(final.attributes[a].name).c_str(),
                   kdmesh::attributeTypeName(final.attributes[a].type), unsigned(final.attributes[a].components),
+                  codingName(final.attributes[a].quantization), unsigned(final.attributes[a].quantization.bits),
                   jsonNumber(cost.attributeBits[a] / n).c_str());
     std::printf("],\n");
     std::printf("  \"bitsPerVertex\": {\"total\": %s, \"geometry\": %s, \"connectivity\": %s},\n",
@@ -484,9 +503,13 @@ int runInfo(const std::string& input, bool json, bool perLevel) {
                 cost.labelBits / n, simplices ? cost.labelBits / double(simplices) : 0.0);
   }
   for (size_t a = 0; a < final.attributes.size(); ++a)
-    std::printf("%s%s (%u %s) %.3f bits/vertex\n", a == 0 ? "attributes      " : "                ",
+    std::printf("%s%s (%u %s, %s%s) %.3f bits/vertex\n", a == 0 ? "attributes      " : "                ",
                 oneLine(final.attributes[a].name).c_str(), unsigned(final.attributes[a].components),
-                kdmesh::attributeTypeName(final.attributes[a].type), cost.attributeBits[a] / n);
+                kdmesh::attributeTypeName(final.attributes[a].type), codingName(final.attributes[a].quantization),
+                final.attributes[a].quantization.bits
+                    ? (" " + std::to_string(final.attributes[a].quantization.bits) + " bits").c_str()
+                    : "",
+                cost.attributeBits[a] / n);
   if (h.maxDimension > 0) {
     // As the paper's Table 1: which operator undid each of the n - 1 merges.
     std::printf("operators       %" PRIu64 " vertex splits (%.1f %% of %u merges), of which %" PRIu64
@@ -573,6 +596,14 @@ int main(int argc, char** argv) {
                      "Largest chunk payload in bytes; the first chunks start at 1 KiB")
       ->check(CLI::Range(64, 1 << 26))
       ->capture_default_str();
+  encode->add_option("--attr-bits", encodeArgs.attributeBits,
+                     "Quantize float32 vertex attributes to N bits per component over each one's range "
+                     "(1-24; lossy; default: exact)")
+      ->check(CLI::Range(1, 24));
+  encode->add_option("--normal-bits", encodeArgs.normalBits,
+                     "Code the float32 x 3 attribute 'normal' as unit vectors in two N-bit octahedral "
+                     "coordinates (2-16; lossy; default: exact, or --attr-bits)")
+      ->check(CLI::Range(2, 16));
   encode->add_flag("--points-only", encodeArgs.pointsOnly,
                    "Drop edges, triangles and tetrahedra and encode the vertices");
   encode->add_flag("--weld", encodeArgs.weld,

@@ -17,6 +17,12 @@
 // component's models are chosen by the bit length of the previous
 // component's difference (colour channels, the axes of a normal, move
 // together) and by how far the neighbours' values spread.
+//
+// Quantized float attributes (AttributeQuantization) are coded the same
+// way on their quantized values, the images: the decoder keeps the float32
+// values they stand for, and the mapping back from those floats to the
+// images is exact (docs/FORMAT.md), so encoder and decoder predict from
+// the same images.
 #pragma once
 
 #include <algorithm>
@@ -36,9 +42,19 @@ namespace kdmesh {
 // repeats, 1..4 components of a known type, one value per vertex.
 Status checkAttributes(const Complex& complex);
 
-// The attribute table: per attribute its type, components, name and the
-// root vertex's values (of input vertex `root`), then a CRC-32 of the table.
-void writeAttributeTable(const std::vector<VertexAttribute>& attributes, uint32_t root, std::vector<uint8_t>& out);
+// How the encoder codes each attribute under `options` (attributeBits,
+// normalBits): in `out`, one per attribute. InvalidArgument for bits out
+// of range, InvalidInput for non-finite values to quantize.
+Status chooseQuantization(const Complex& complex, const EncodeOptions& options,
+                          std::vector<AttributeQuantization>& out);
+
+// The attribute table: per attribute its type, components, name, coding
+// (`quantization`, one per attribute) and the root vertex's values (of
+// input vertex `root`, as the decoder will hold them), then a CRC-32 of
+// the table.
+void writeAttributeTable(const std::vector<VertexAttribute>& attributes,
+                         const std::vector<AttributeQuantization>& quantization, uint32_t root,
+                         std::vector<uint8_t>& out);
 // Reads a table of `count` attributes from in[0..available) into `out`:
 // their descriptors, each with one vertex's values (the root's). Incomplete
 // (and `out` untouched) until the whole table is there; Malformed (with
@@ -48,15 +64,19 @@ Parsed readAttributeTable(const uint8_t* in, size_t available, uint8_t count, st
 
 class AttributeCoder {
  public:
-  explicit AttributeCoder(const std::vector<VertexAttribute>& attributes);
+  // Codes the attributes as `quantization` says (one per attribute), or
+  // without it as each attribute's own field says (the decoder's table).
+  explicit AttributeCoder(const std::vector<VertexAttribute>& attributes,
+                          const std::vector<AttributeQuantization>* quantization = nullptr);
 
-  // A new vertex's values of one attribute predicted: `values`, the
-  // rounded mean of its neighbours' (their images), or its parent's without
-  // neighbours; `spread`, per component, the bit length of the range of the
+  // A new vertex's values of one attribute predicted, as images: `images`,
+  // the rounded mean of its neighbours' (octahedral normals: the image of
+  // the sum of their normals), or its parent's without neighbours;
+  // `spread`, per coded component, the bit length of the range of the
   // neighbours' images (0 without neighbours), which says how far to trust
   // the mean.
   struct Prediction {
-    uint8_t values[16];
+    uint32_t images[4];
     uint8_t spread[4];
   };
   // valuesOf(id) gives a vertex's values.
@@ -65,22 +85,35 @@ class AttributeCoder {
                Prediction& out) const {
     const Layout& layout = layouts_[a];
     if (neighbours.empty()) {
-      std::copy(parent, parent + layout.components * layout.bytes, out.values);
+      images(layout, parent, out.images);
       std::fill(out.spread, out.spread + 4, uint8_t(0));
       return;
     }
-    for (int c = 0; c < layout.components; ++c) {
-      uint64_t sum = 0;
-      uint32_t low = 0xffffffffu, high = 0;
-      for (const uint32_t v : neighbours) {
-        const uint32_t value = image(layout, valuesOf(v), c);
-        sum += value;
-        low = std::min(low, value);
-        high = std::max(high, value);
+    uint64_t sum[4] = {0, 0, 0, 0};
+    uint32_t low[4] = {0xffffffffu, 0xffffffffu, 0xffffffffu, 0xffffffffu}, high[4] = {0, 0, 0, 0};
+    double direction[3] = {0, 0, 0};
+    for (const uint32_t v : neighbours) {
+      const uint8_t* values = valuesOf(v);
+      uint32_t image[4];
+      images(layout, values, image);
+      for (int c = 0; c < layout.components; ++c) {
+        sum[c] += image[c];
+        low[c] = std::min(low[c], image[c]);
+        high[c] = std::max(high[c], image[c]);
       }
-      store(layout, out.values, c, uint32_t((sum + neighbours.size() / 2) / neighbours.size()));
-      out.spread[c] = uint8_t(bitLength(high - low));
+      // The normal the image stands for: the encoder's input values are
+      // not the decoder's.
+      if (layout.kind == AttributeQuantization::Octahedral) {
+        uint8_t normal[12];
+        store(layout, normal, image);
+        addNormal(normal, direction);
+      }
     }
+    for (int c = 0; c < layout.components; ++c) {
+      out.images[c] = uint32_t((sum[c] + neighbours.size() / 2) / neighbours.size());
+      out.spread[c] = uint8_t(bitLength(high[c] - low[c]));
+    }
+    if (layout.kind == AttributeQuantization::Octahedral) octahedralImages(layout, direction, out.images);
   }
 
   // Codes the values of one vertex of attribute `a` (encoder: `child`; the
@@ -88,17 +121,39 @@ class AttributeCoder {
   template <class Coder>
   void code(Coder& coder, size_t a, const Prediction& prediction, uint8_t* child) {
     const Layout& layout = layouts_[a];
+    uint32_t to[4], coded[4];
+    images(layout, child, to);  // the encoder's values; ignored by the decoder
     int previousLength = 0;
     for (int c = 0; c < layout.components; ++c) {
-      const uint32_t from = image(layout, prediction.values, c);
-      const uint32_t to = image(layout, child, c);  // the encoder's value; ignored by the decoder
+      const uint32_t from = prediction.images[c];
       const size_t context = (size_t(c) * kLengthClasses + size_t(lengthClass(previousLength))) * kLengthClasses +
                              size_t(lengthClass(prediction.spread[c]));
       const uint32_t difference = codeDifference(coder, models_[layout.firstModels + context], layout.bits,
-                                                 (to - from) & layout.mask, previousLength);
-      store(layout, child, c, (from + difference) & layout.mask);
+                                                 (to[c] - from) & layout.mask, previousLength);
+      coded[c] = (from + difference) & layout.mask;
     }
+    store(layout, child, coded);
   }
+
+  // How an attribute is coded: its coded components (2 for octahedral
+  // normals), their width and the quantization's parameters.
+  struct Layout {
+    AttributeType type;
+    int components, bytes, bits;
+    uint32_t mask;
+    size_t firstModels;
+    AttributeQuantization::Kind kind;
+    uint32_t top;  // the largest quantized value
+    double minimum[4], step[4];
+  };
+  static Layout layoutOf(const VertexAttribute& attribute, const AttributeQuantization& quantization,
+                         size_t firstModels);
+  // A vertex's values as unsigned integers (images), one per coded
+  // component: exact values' bits, floats in value order; quantized values
+  // their quantization (clamped to its range).
+  static void images(const Layout& layout, const uint8_t* values, uint32_t* out);
+  // The values that images stand for (clamped to the quantization's range).
+  static void store(const Layout& layout, uint8_t* values, const uint32_t* images);
 
  private:
   struct Models {
@@ -106,17 +161,10 @@ class AttributeCoder {
     std::array<BitModel, 32> length;   // unary: longer than i + 1 bits?
     std::array<BitModel, 64> leading;  // the two bits after the leading one, by length
   };
-  struct Layout {
-    AttributeType type;
-    int components, bytes, bits;
-    uint32_t mask;
-    size_t firstModels;
-  };
   static constexpr int kLengthClasses = 4;
   static int lengthClass(int length) { return length == 0 ? 0 : length <= 2 ? 1 : length <= 5 ? 2 : 3; }
-  // A value's bits as an unsigned integer, floats in value order.
-  static uint32_t image(const Layout& layout, const uint8_t* values, int component);
-  static void store(const Layout& layout, uint8_t* values, int component, uint32_t image);
+  static void addNormal(const uint8_t* values, double* sum);
+  static void octahedralImages(const Layout& layout, const double* direction, uint32_t* out);
 
   // Codes a `bits`-bit difference (two's complement); returns it and the
   // bit length of its magnitude in `length`.

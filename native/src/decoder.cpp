@@ -531,6 +531,7 @@ struct Decoder::State {
       out.attributes[a].name = attributes[a].name;
       out.attributes[a].type = attributes[a].type;
       out.attributes[a].components = attributes[a].components;
+      out.attributes[a].quantization = attributes[a].quantization;
       out.attributes[a].values.clear();
       if (connectivity) {
         const uint8_t* values = attributes[a].values.data();

@@ -256,6 +256,8 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options) {
 EncodeResult encode(const Complex& complex, const EncodeOptions& options, TrainedModels* finalModels) {
   EncodeResult result;
   if (result.status = checkOptions(complex, options); !result.status.ok()) return result;
+  std::vector<AttributeQuantization> quantization;  // how each attribute is coded
+  if (result.status = chooseQuantization(complex, options, quantization); !result.status.ok()) return result;
   auto report = [&](const char* phase, double fraction) {
     if (options.progress) options.progress({phase, fraction});
   };
@@ -322,9 +324,9 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
   // its new vertex's attributes. The attribute table comes first.
   std::vector<uint8_t> body;
   header.attributeCount = uint8_t(complex.attributes.size());
-  if (named) writeAttributeTable(complex.attributes, order.vertices[0], body);
+  if (named) writeAttributeTable(complex.attributes, quantization, order.vertices[0], body);
   if (header.labelled) writeLabelTable(labelTable, body);
-  AttributeCoder attributeCoder(complex.attributes);
+  AttributeCoder attributeCoder(complex.attributes, &quantization);
   result.cost.attributeBits.assign(complex.attributes.size(), 0.0);
   ChunkWriter chunks(body, options.chunkBytes);
   RangeEncoder& coder = chunks.coder();

@@ -10,6 +10,8 @@
 #include <map>
 #include <random>
 
+#include "attribute_support.h"
+#include "attributes.h"
 #include "complexes.h"
 #include "kdmesh/io.h"
 #include "shapes.h"
@@ -17,114 +19,6 @@
 
 namespace kdmesh::test {
 namespace {
-
-template <class T>
-VertexAttribute attribute(const std::string& name, AttributeType type, uint8_t components, const std::vector<T>& values) {
-  VertexAttribute a{name, type, components, {}};
-  a.values.resize(values.size() * sizeof(T));
-  std::memcpy(a.values.data(), values.data(), a.values.size());
-  return a;
-}
-
-// One attribute of every type, made from the positions and a seed: smooth
-// colours, unit normals with special float values mixed in, signed labels.
-std::vector<VertexAttribute> everyKind(const Complex& c, uint32_t seed) {
-  std::mt19937 rng(seed);
-  const size_t n = c.vertexCount();
-  std::vector<uint8_t> colour, small;
-  std::vector<int8_t> signedByte;
-  std::vector<uint16_t> intensity;
-  std::vector<int16_t> offset;
-  std::vector<uint32_t> id;
-  std::vector<int32_t> label;
-  std::vector<float> normal, uv;
-  const float special[] = {-0.0f, std::numeric_limits<float>::infinity(), -std::numeric_limits<float>::infinity(),
-                           std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::denorm_min(),
-                           -std::numeric_limits<float>::max()};
-  for (size_t v = 0; v < n; ++v) {
-    const float* p = &c.positions[3 * v];
-    for (int k = 0; k < 3; ++k) colour.push_back(uint8_t(int(128 + 100 * std::sin(p[k] * 2.f)) & 0xff));
-    small.push_back(uint8_t(rng() % 3));
-    signedByte.push_back(int8_t(rng() % 256));
-    intensity.push_back(uint16_t(30000 + 20000 * std::cos(p[0])));
-    offset.push_back(int16_t(int(rng() % 65536) - 32768));
-    id.push_back(uint32_t(v) * 2654435761u);
-    label.push_back(int32_t(rng() % 7) - 3);
-    const float length = std::sqrt(p[0] * p[0] + p[1] * p[1] + p[2] * p[2]) + 1e-6f;
-    for (int k = 0; k < 3; ++k) normal.push_back(rng() % 50 == 0 ? special[rng() % 6] : p[k] / length);
-    uv.push_back(p[0] * 0.1f);
-    uv.push_back(p[1] * 0.1f);
-  }
-  return {attribute("color", AttributeType::UInt8, 3, colour),  attribute("flag", AttributeType::UInt8, 1, small),
-          attribute("tilt", AttributeType::Int8, 1, signedByte), attribute("intensity", AttributeType::UInt16, 1, intensity),
-          attribute("offset", AttributeType::Int16, 1, offset), attribute("id", AttributeType::UInt32, 1, id),
-          attribute("label", AttributeType::Int32, 1, label),   attribute("normal", AttributeType::Float32, 3, normal),
-          attribute("uv", AttributeType::Float32, 2, uv)};
-}
-
-// A vertex as its position bits followed by every attribute's bytes.
-using VertexKey = std::vector<uint8_t>;
-std::vector<VertexKey> vertexKeys(const Complex& c) {
-  std::vector<VertexKey> keys(c.vertexCount());
-  for (size_t v = 0; v < keys.size(); ++v) {
-    const uint8_t* p = reinterpret_cast<const uint8_t*>(&c.positions[3 * v]);
-    keys[v].assign(p, p + 12);
-    for (const VertexAttribute& a : c.attributes) {
-      const uint8_t* values = a.values.data() + v * a.valueBytes();
-      keys[v].insert(keys[v].end(), values, values + a.valueBytes());
-    }
-  }
-  return keys;
-}
-
-void expectSameDescriptors(const Complex& input, const Complex& decoded) {
-  ASSERT_EQ(decoded.attributes.size(), input.attributes.size());
-  for (size_t a = 0; a < input.attributes.size(); ++a) {
-    EXPECT_EQ(decoded.attributes[a].name, input.attributes[a].name);
-    EXPECT_EQ(decoded.attributes[a].type, input.attributes[a].type);
-    EXPECT_EQ(decoded.attributes[a].components, input.attributes[a].components);
-    ASSERT_EQ(decoded.attributes[a].values.size(), decoded.vertexCount() * input.attributes[a].valueBytes());
-  }
-}
-
-// Lossless: the same vertices (position and values) up to order, the same
-// complex, and every prefix's vertices with some input vertex's values.
-void expectRoundTrip(const Complex& input, const EncodeOptions& options) {
-  const EncodeResult encoded = encode(input, options);
-  ASSERT_TRUE(encoded.status.ok()) << encoded.status.message;
-  Decoder decoder;
-  ASSERT_TRUE(decoder.push(encoded.bytes.data(), encoded.bytes.size()).ok());
-  ASSERT_TRUE(decoder.finish().ok());
-  EXPECT_EQ(decoder.header().attributeCount, input.attributes.size());
-  const Complex decoded = decoder.snapshot();
-  expectSameDescriptors(input, decoded);
-  // Positions are exact in float32 mode only: elsewhere the values alone.
-  const size_t skip = options.exact ? 0 : 12;
-  auto keys = [skip](const Complex& c) {
-    std::vector<VertexKey> out;
-    for (const VertexKey& key : vertexKeys(c)) out.emplace_back(key.begin() + std::ptrdiff_t(skip), key.end());
-    std::sort(out.begin(), out.end());
-    return out;
-  };
-  EXPECT_TRUE(keys(decoded) == keys(input)) << "vertices and their values differ";
-  if (input.hasSimplices() && options.exact) {
-    EXPECT_EQ(canonicalForm(decoded), canonicalForm(input));
-  }
-
-  // Values of the input, whatever the position (a prefix's vertices stand
-  // at their cells).
-  std::set<VertexKey> inputValues;
-  for (VertexKey key : vertexKeys(input)) inputValues.insert(VertexKey(key.begin() + 12, key.end()));
-  for (const ChunkInfo& chunk : decoder.chunks()) {
-    Decoder prefix;
-    ASSERT_TRUE(prefix.push(encoded.bytes.data(), chunk.offset).ok());
-    const Complex coarse = prefix.snapshot();
-    if (!prefix.hasHeader() || coarse.attributes.empty()) continue;
-    expectSameDescriptors(input, coarse);
-    for (const VertexKey& key : vertexKeys(coarse))
-      ASSERT_TRUE(inputValues.count(VertexKey(key.begin() + 12, key.end()))) << "prefix of " << chunk.offset;
-  }
-}
 
 TEST(Attributes, EveryTypeRoundTripsOnAMesh) {
   Complex mesh = torusMesh(14, 22);
@@ -274,7 +168,7 @@ TEST(Attributes, PlyKeepsThemAndOtherFormatsRefuseThem) {
   ASSERT_EQ(back.attributes.size(), 1u);
   EXPECT_EQ(back.attributes[0].name, "weights");
   EXPECT_EQ(back.attributes[0].components, 2);
-  for (const io::Format format : {io::Format::Obj, io::Format::Off, io::Format::Xyz, io::Format::Vtk}) {
+  for (const io::Format format : {io::Format::Obj, io::Format::Off, io::Format::Xyz}) {
     const Status s = io::writeMemory(format, mesh, file);
     EXPECT_EQ(s.code, ErrorCode::InvalidArgument) << io::formatName(format);
     EXPECT_NE(s.message.find("write PLY"), std::string::npos) << s.message;
@@ -300,6 +194,185 @@ TEST(Attributes, WeldingKeepsVerticesWhoseValuesDiffer) {
   ASSERT_EQ(c.attributes.size(), 1u);
   EXPECT_EQ(c.attributes[0].values, (std::vector<uint8_t>{1, 2, 3, 9, 9, 9, 1, 2, 3}));
   EXPECT_EQ(c.triangles, (std::vector<uint32_t>{0, 1, 2}));
+}
+
+}  // namespace
+}  // namespace kdmesh::test
+
+namespace kdmesh::test {
+namespace {
+
+// Quantized values stand for floats whose images are those values again,
+// so that encoder and decoder predict from the same images: every
+// octahedral image of every dequantized normal is a fixed point, and inside
+// the square's edges every quantized pair is its own image.
+TEST(AttributeQuantization, OctahedralImagesOfDequantizedNormalsAreFixedPoints) {
+  const VertexAttribute normal{"normal", AttributeType::Float32, 3, {}, {}};
+  for (int bits = 2; bits <= 12; ++bits) {
+    AttributeQuantization q;
+    q.kind = AttributeQuantization::Octahedral;
+    q.bits = uint8_t(bits);
+    const AttributeCoder::Layout layout = AttributeCoder::layoutOf(normal, q, 0);
+    const uint32_t top = (1u << bits) - 2;
+    ASSERT_EQ(layout.top, top);
+    uint8_t values[12], again[12];
+    for (uint32_t u = 0; u <= top; ++u)
+      for (uint32_t v = 0; v <= top; ++v) {
+        const uint32_t in[2] = {u, v};
+        uint32_t image[2], second[2];
+        AttributeCoder::store(layout, values, in);
+        AttributeCoder::images(layout, values, image);
+        if (u > 0 && u < top && v > 0 && v < top) {
+          ASSERT_TRUE(image[0] == u && image[1] == v) << bits << " bits: " << u << ", " << v;
+        }
+        AttributeCoder::store(layout, again, image);
+        AttributeCoder::images(layout, again, second);
+        ASSERT_TRUE(second[0] == image[0] && second[1] == image[1]) << bits << " bits: " << u << ", " << v;
+        ASSERT_EQ(std::memcmp(values, again, 12), 0) << bits << " bits: " << u << ", " << v;
+        float n[3];
+        std::memcpy(n, values, 12);
+        ASSERT_NEAR(double(n[0]) * n[0] + double(n[1]) * n[1] + double(n[2]) * n[2], 1.0, 1e-6);
+      }
+  }
+}
+
+TEST(AttributeQuantization, UniformImagesOfDequantizedValuesAreFixedPoints) {
+  std::mt19937 rng(5);
+  // Ranges of every scale, narrow ranges far from 0 (where the step is held
+  // at 2^-22 of the magnitude), constants and ranges across 0.
+  const std::vector<std::pair<float, float>> ranges = {
+      {0.f, 1.f}, {-1.f, 1.f}, {1000.f, 1000.001f}, {-3e7f, 5e-3f}, {7.f, 7.f}, {1e-30f, 3e-30f}, {-1e30f, 1e30f}};
+  for (const int bits : {1, 5, 12, 16, 20, 24}) {
+    for (const auto& [low, high] : ranges) {
+      Complex c = pointCloud({0, 0, 0, 1, 1, 1});
+      c.attributes = {attribute("x", AttributeType::Float32, 1, std::vector<float>{low, high})};
+      EncodeOptions options;
+      options.attributeBits = bits;
+      std::vector<AttributeQuantization> q;
+      ASSERT_TRUE(chooseQuantization(c, options, q).ok());
+      ASSERT_EQ(q[0].kind, AttributeQuantization::Uniform);
+      const AttributeCoder::Layout layout = AttributeCoder::layoutOf(c.attributes[0], q[0], 0);
+      // Both ends of the range are within half a step of their value.
+      for (const float x : {low, high}) {
+        uint32_t image;
+        float back;
+        AttributeCoder::images(layout, reinterpret_cast<const uint8_t*>(&x), &image);
+        AttributeCoder::store(layout, reinterpret_cast<uint8_t*>(&back), &image);
+        EXPECT_LE(std::fabs(double(back) - double(x)), 0.5 * double(q[0].step[0]) + std::fabs(double(x)) * 1e-7)
+            << bits << " bits, " << low << ".." << high;
+      }
+      // Every image up to the range's end (those the encoder makes).
+      uint32_t top;
+      AttributeCoder::images(layout, reinterpret_cast<const uint8_t*>(&high), &top);
+      ASSERT_LE(top, layout.top);
+      for (int i = 0; i < 4096; ++i) {
+        const uint32_t image = i < 2048 ? std::min<uint32_t>(uint32_t(i), top) : uint32_t(rng() % (uint64_t(top) + 1));
+        float value;
+        uint32_t again;
+        AttributeCoder::store(layout, reinterpret_cast<uint8_t*>(&value), &image);
+        AttributeCoder::images(layout, reinterpret_cast<const uint8_t*>(&value), &again);
+        ASSERT_EQ(again, q[0].step[0] == 0 ? 0u : image) << bits << " bits, " << low << ".." << high;
+      }
+    }
+  }
+}
+
+// Quantized attributes decode to the quantized input values: every vertex,
+// and every prefix's, has the dequantized values of an input vertex, and
+// they are within the quantization's error of the input.
+TEST(AttributeQuantization, DecodesToTheQuantizedInputOnEveryPrefix) {
+  Complex mesh = sphereMesh(16, 24);
+  std::vector<float> normals, uv, weight;
+  std::vector<uint8_t> colour;
+  for (size_t v = 0; v < mesh.vertexCount(); ++v) {
+    const float* p = &mesh.positions[3 * v];
+    normals.insert(normals.end(), p, p + 3);  // a unit sphere: its normals
+    uv.insert(uv.end(), {std::atan2(p[1], p[0]), p[2] * 0.5f + 0.5f});
+    weight.push_back(float(v % 7) - 2.5f);
+    colour.insert(colour.end(), {uint8_t(v), uint8_t(v * 3), uint8_t(v * 7)});
+  }
+  mesh.attributes = {attribute("normal", AttributeType::Float32, 3, normals),
+                     attribute("uv", AttributeType::Float32, 2, uv),
+                     attribute("weight", AttributeType::Float32, 1, weight),
+                     attribute("color", AttributeType::UInt8, 3, colour)};
+  for (const auto& [attributeBits, normalBits] : {std::pair{12, 10}, std::pair{6, 0}, std::pair{0, 8}}) {
+    SCOPED_TRACE(std::to_string(attributeBits) + " attribute bits, " + std::to_string(normalBits) + " normal bits");
+    EncodeOptions options;
+    options.exact = true;
+    options.attributeBits = attributeBits;
+    options.normalBits = normalBits;
+    options.chunkBytes = 256;
+    const EncodeResult encoded = encode(mesh, options);
+    ASSERT_TRUE(encoded.status.ok()) << encoded.status.message;
+    Complex decoded;
+    ASSERT_TRUE(decode(encoded.bytes.data(), encoded.bytes.size(), decoded).ok());
+    expectSameDescriptors(mesh, decoded);
+    // The input as the stream holds it: its values quantized and back.
+    Complex expected = mesh;
+    for (size_t a = 0; a < mesh.attributes.size(); ++a) {
+      const AttributeQuantization& q = decoded.attributes[a].quantization;
+      const AttributeQuantization::Kind kind =
+          mesh.attributes[a].type != AttributeType::Float32 ? AttributeQuantization::Exact
+          : a == 0 && normalBits > 0                        ? AttributeQuantization::Octahedral
+          : attributeBits > 0                               ? AttributeQuantization::Uniform
+                                                            : AttributeQuantization::Exact;
+      ASSERT_EQ(q.kind, kind) << mesh.attributes[a].name;
+      const AttributeCoder::Layout layout = AttributeCoder::layoutOf(mesh.attributes[a], q, 0);
+      VertexAttribute& values = expected.attributes[a];
+      for (size_t v = 0; v < mesh.vertexCount(); ++v) {
+        uint32_t images[4];
+        AttributeCoder::images(layout, &mesh.attributes[a].values[v * values.valueBytes()], images);
+        AttributeCoder::store(layout, &values.values[v * values.valueBytes()], images);
+      }
+      // Within the quantization's error of the input.
+      for (size_t i = 0; kind != AttributeQuantization::Exact && i < values.values.size() / 4; ++i) {
+        float in, out;
+        std::memcpy(&in, &mesh.attributes[a].values[4 * i], 4);
+        std::memcpy(&out, &values.values[4 * i], 4);
+        const double bound = kind == AttributeQuantization::Uniform ? 0.5 * q.step[i % values.components] * 1.0001
+                                                                    : 4.0 / double(1 << q.bits);
+        ASSERT_LE(std::fabs(double(in) - double(out)), bound) << mesh.attributes[a].name << " value " << i;
+      }
+    }
+    auto sortedKeys = [](const Complex& c) {
+      std::vector<VertexKey> keys = vertexKeys(c);
+      std::sort(keys.begin(), keys.end());
+      return keys;
+    };
+    EXPECT_TRUE(sortedKeys(decoded) == sortedKeys(expected)) << "decoded values are not the quantized input";
+    std::set<VertexKey> values;
+    for (const VertexKey& key : vertexKeys(expected)) values.insert(VertexKey(key.begin() + 12, key.end()));
+    Decoder whole;
+    ASSERT_TRUE(whole.push(encoded.bytes.data(), encoded.bytes.size()).ok());
+    ASSERT_GT(whole.chunks().size(), 2u);
+    for (const ChunkInfo& chunk : whole.chunks()) {
+      Decoder prefix;
+      ASSERT_TRUE(prefix.push(encoded.bytes.data(), chunk.offset).ok());
+      if (!prefix.hasHeader()) continue;
+      const Complex coarse = prefix.snapshot();
+      if (coarse.attributes.empty()) continue;
+      expectSameDescriptors(mesh, coarse);
+      for (const VertexKey& key : vertexKeys(coarse))
+        ASSERT_TRUE(values.count(VertexKey(key.begin() + 12, key.end()))) << "prefix of " << chunk.offset;
+    }
+  }
+}
+
+TEST(AttributeQuantization, BadOptionsAndNonFiniteValuesAreRefused) {
+  Complex c = pointCloud({0, 0, 0, 1, 1, 1});
+  c.attributes = {attribute("normal", AttributeType::Float32, 3, std::vector<float>{0, 0, 1, 0, NAN, 1})};
+  EncodeOptions options;
+  EXPECT_TRUE(encode(c, options).status.ok());  // exact keeps NaN
+  options.normalBits = 17;
+  EXPECT_EQ(encode(c, options).status.code, ErrorCode::InvalidArgument);
+  options.normalBits = 0;
+  options.attributeBits = 25;
+  EXPECT_EQ(encode(c, options).status.code, ErrorCode::InvalidArgument);
+  options.attributeBits = 0;
+  options.normalBits = 8;
+  const Status s = encode(c, options).status;
+  EXPECT_EQ(s.code, ErrorCode::InvalidInput);
+  EXPECT_NE(s.message.find("attribute 'normal' of vertex 1 is not finite"), std::string::npos) << s.message;
 }
 
 }  // namespace

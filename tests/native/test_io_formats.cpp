@@ -161,7 +161,7 @@ TEST(IoStl, BinarySoupKeepsBitsEvenWhenTheHeaderStartsWithSolid) {
       expected.insert(expected.end(), t.corners.begin(), t.corners.end());
     }
     EXPECT_EQ(bitsOf(r.complex.positions), bitsOf(expected));
-    EXPECT_TRUE(r.hasNote("attribute values (often a colour) of 1 triangles")) << joined(r.notes);
+    EXPECT_TRUE(r.hasNote("attribute values (often a colour) of 1 triangle")) << joined(r.notes);
     EXPECT_TRUE(r.hasNote("facet normals of")) << joined(r.notes);
     EXPECT_EQ(r.notes.size(), 2u) << joined(r.notes);
   }
@@ -255,7 +255,7 @@ TEST(IoStl, WeldMergesBitIdenticalVerticesOnly) {
   ASSERT_TRUE(welded.status.ok()) << welded.status.message;
   EXPECT_EQ(welded.complex.vertexCount(), 5u);
   EXPECT_EQ(welded.complex.triangles, (std::vector<uint32_t>{0, 1, 2}));
-  EXPECT_TRUE(welded.hasNote("dropped 1 simplices that welding left with a repeated vertex"))
+  EXPECT_TRUE(welded.hasNote("dropped 1 simplex that welding left with a repeated vertex"))
       << joined(welded.notes);
 
   // readFile passes the option on.
@@ -403,8 +403,12 @@ TEST(IoMedit, ReadsCommentsCrlfWrappedValuesQuadsAndSkippedSections) {
     EXPECT_TRUE(r.hasNote("split 1 polygon with")) << joined(r.notes);
     EXPECT_TRUE(r.hasNote("skipped 2 Corners")) << joined(r.notes);
     EXPECT_TRUE(r.hasNote("skipped 1 Hexahedra")) << joined(r.notes);
-    EXPECT_TRUE(r.hasNote("nonzero references of 2 vertices")) << joined(r.notes);
-    // Element references are the simplices' labels.
+    // Vertex references are the attribute ref; element references the
+    // simplices' labels.
+    ASSERT_EQ(r.complex.attributes.size(), 1u);
+    EXPECT_EQ(r.complex.attributes[0].name, "ref");
+    EXPECT_EQ(r.complex.attributes[0].type, AttributeType::UInt8);
+    EXPECT_EQ(r.complex.attributes[0].values, (std::vector<uint8_t>{1, 0, 0, 0, 7}));
     EXPECT_EQ(r.complex.labels.edges, (std::vector<int32_t>{0}));
     EXPECT_EQ(r.complex.labels.triangles, (std::vector<int32_t>{3, 3, 0}));
     EXPECT_EQ(r.complex.labels.tetrahedra, (std::vector<int32_t>{2}));
@@ -527,7 +531,14 @@ TEST(IoTetgen, ReadsHandWrittenFilesNumberedFromZeroOrOne) {
   EXPECT_EQ(bitsOf(zero.complex.positions),
             bitsOf(std::vector<float>{0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0, 1, 0.1f, 0.2f, 0.3f}));
   EXPECT_EQ(zero.complex.tetrahedra, (std::vector<uint32_t>{0, 1, 2, 3, 4, 3, 2, 1}));
-  EXPECT_TRUE(zero.hasNote("2 attributes and the boundary marker")) << joined(zero.notes);
+  // The point attributes and the boundary markers are attributes.
+  ASSERT_EQ(zero.complex.attributes.size(), 2u);
+  EXPECT_EQ(zero.complex.attributes[0].name, "attribute");
+  EXPECT_EQ(zero.complex.attributes[0].components, 2);
+  EXPECT_EQ(zero.complex.attributes[0].values.size(), 40u);
+  EXPECT_EQ(zero.complex.attributes[1].name, "marker");
+  EXPECT_EQ(zero.complex.attributes[1].type, AttributeType::UInt8);
+  EXPECT_EQ(zero.complex.attributes[1].values, (std::vector<uint8_t>{1, 0, 0, 0, 0}));
   EXPECT_EQ(zero.complex.labels.tetrahedra, (std::vector<int32_t>{-1, -1}));  // the region attribute
 
   // Numbered from 1, header without attribute counts, 10-node tetrahedra.
@@ -680,7 +691,10 @@ TEST(IoVtk, ReadsUnstructuredGridWithEveryCellKindCrlfAndIgnoredData) {
       "POINT_DATA 6\n"
       "SCALARS s float 1\n"
       "LOOKUP_TABLE default\n"
-      "1 2 3 4 5 6\n";
+      "1 2 3 4 5 6\n"
+      "CELL_DATA 10\n"
+      "SCALARS region int\n"
+      "1 1 1 1 1 1 1 1 1 2\n";
   for (const std::string& variant : {text, crlf(text)}) {
     const ReadResult r = readText(Format::Vtk, variant);
     ASSERT_TRUE(r.status.ok()) << r.status.message;
@@ -695,9 +709,13 @@ TEST(IoVtk, ReadsUnstructuredGridWithEveryCellKindCrlfAndIgnoredData) {
                                      5, 4, 3, 0, 2, 4, 0, 4, 5}));
     EXPECT_EQ(r.complex.tetrahedra, (std::vector<uint32_t>{0, 1, 2, 3}));
     EXPECT_TRUE(r.hasNote("split 3 polygons")) << joined(r.notes);
-    EXPECT_TRUE(r.hasNote("skipped 1 cells")) << joined(r.notes);
+    EXPECT_TRUE(r.hasNote("skipped 1 cell that is")) << joined(r.notes);
     EXPECT_TRUE(r.hasNote("types 12 x1")) << joined(r.notes);
-    EXPECT_TRUE(r.hasNote("ignored POINT_DATA")) << joined(r.notes);
+    ASSERT_EQ(r.complex.attributes.size(), 1u);
+    EXPECT_EQ(r.complex.attributes[0].name, "s");
+    EXPECT_EQ(r.complex.attributes[0].type, AttributeType::Float32);
+    EXPECT_EQ(r.complex.attributes[0].values.size(), 24u);
+    EXPECT_TRUE(r.hasNote("ignored 1 data array (cell data")) << joined(r.notes);
     EXPECT_TRUE(r.hasNote("double")) << joined(r.notes);
     EXPECT_TRUE(r.hasNote("ignored 1 FIELD")) << joined(r.notes);
   }
@@ -751,7 +769,7 @@ TEST(IoVtk, ReadsVersion5OffsetsAndPolyData) {
   EXPECT_EQ(r.complex.tetrahedra, (std::vector<uint32_t>{0, 1, 2, 3}));
   EXPECT_EQ(r.complex.triangles, (std::vector<uint32_t>{3, 2, 1}));
   EXPECT_EQ(r.complex.edges, (std::vector<uint32_t>{0, 3}));
-  EXPECT_TRUE(r.hasNote("ignored CELL_DATA")) << joined(r.notes);
+  EXPECT_TRUE(r.complex.attributes.empty());
 
   const std::string polyData =
       "# vtk DataFile Version 3.0\n"

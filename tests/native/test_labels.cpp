@@ -448,8 +448,12 @@ TEST(LabelFiles, MeditReferences) {
   EXPECT_EQ(c.labels.tetrahedra, (std::vector<int32_t>{5, 6}));
   EXPECT_EQ(c.labels.triangles, (std::vector<int32_t>{9, 8}));
   EXPECT_EQ(c.labels.edges, (std::vector<int32_t>{2}));
-  EXPECT_NE(joined(notes).find("references of 1 vertices"), std::string::npos) << joined(notes);
-  EXPECT_NE(joined(notes).find("dropped the nonzero references of 1 edges and triangles"), std::string::npos)
+  // The vertex references are the attribute ref.
+  ASSERT_EQ(c.attributes.size(), 1u);
+  EXPECT_EQ(c.attributes[0].name, "ref");
+  EXPECT_EQ(c.attributes[0].values, (std::vector<uint8_t>{1, 0, 0, 0, 0, 0}));
+  EXPECT_NE(joined(notes).find("dropped the nonzero references of 1 edge or triangle that is a face"),
+            std::string::npos)
       << joined(notes);
   // Through the codec: the face's reference goes, the others stay.
   const EncodeResult encoded = encode(c, exactOptions());

@@ -61,22 +61,60 @@ struct ReadOptions {
 // - Medit: Dimension 3 only. Quadrilaterals are split into two triangles
 //   (a note says how many); Hexahedra, Prisms, Pyramids, P2/Q2 elements and
 //   known per-item sections (Corners, Ridges, Required*, Normals, ...) are
-//   skipped with a note; any other keyword is an error naming it. References
-//   are ignored.
+//   skipped with a note; any other keyword is an error naming it. Vertex
+//   references become the attribute `ref` (unless all are 0), of the
+//   narrowest integer type that holds them (uint8, int8, uint16, ...);
+//   element references are counted in a note. The writer writes `ref`.
 // - TetGen: readFile on x.node or x.ele reads both files (x.ele is optional
 //   when x.node is given: without it the nodes are a point cloud). Point
 //   numbers may start at 0 or 1; 10-node tetrahedra keep their 4 corners.
+//   The .node point attributes become the attribute `attribute` (float32,
+//   up to 4 components; more are grouped by 4 as `attribute_0`,
+//   `attribute_4`, ...) and the boundary markers `marker`, of the narrowest
+//   integer type that holds them; the writer writes both back. Region
+//   attributes of the .ele are counted in a note.
 //   readMemory can read one buffer only, so it reads a .node alone.
 // - VTK: legacy ascii UNSTRUCTURED_GRID or POLYDATA, cells in the classic
 //   layout or the OFFSETS/CONNECTIVITY layout of version 5. Vertex and
 //   poly-vertex cells become points, lines and poly-lines edges, triangles
 //   and strips triangles, tetrahedra tetrahedra; quads and polygons are split
 //   into triangles with a note, other cell types are skipped with a note.
-//   POINT_DATA, CELL_DATA and FIELD data are ignored. Binary VTK is an error.
+//   POINT_DATA arrays of 1 to 4 components become vertex attributes named
+//   as in the file, of the file's type (integers of up to 32 bits as such;
+//   float and double as float32, double rounded with a note; 64-bit
+//   integers as the narrowest type that holds their values), except NORMALS
+//   as `normal`, TEXTURE_COORDINATES as `uv` and COLOR_SCALARS as `color`,
+//   uint8 = 255 x value rounded, as VTK stores them. SCALARS, VECTORS,
+//   GLOBAL_IDS, PEDIGREE_IDS and FIELD arrays of one tuple per point are
+//   read; TENSORS, lookup tables, CELL_DATA and the dataset's FIELD data are
+//   skipped and counted in a note. The writer gives `normal`, `uv` and a
+//   uint8 `color` their keywords, every other attribute SCALARS of its type.
+//   Binary VTK is an error.
+// - OBJ: a corner v/vt/vn that names a texture coordinate or a normal makes
+//   a vertex of its own for each distinct (v, vt, vn) triple, with the
+//   attributes `uv` (float32 × 2, or × 3 when a vt line gives w; absent
+//   coordinates 0) and `normal` (float32 × 3): a seam's vertices share a
+//   position and keep their own values. A corner without vt or vn (v alone,
+//   or v//vn without vt) gets 0 for what it lacks; it is the v line's own
+//   vertex, shared by every such corner, as are the v lines no corner
+//   names. Points (p) may name vt and vn too, as the writer does for
+//   vertices in no face or line. vt and vn lines no corner names are
+//   counted in a note. The writer writes each distinct position, texture
+//   coordinate and normal once, and a vertex whose whole corner equals
+//   another vertex's on a v line of its own.
 Status readMemory(Format format, const uint8_t* data, size_t size,
                   Complex& out, Notes& notes, const ReadOptions& options = {});
 Status readFile(const std::string& path, Complex& out, Notes& notes,
                 const ReadOptions& options = {});
+
+// Whether files of `format` hold the vertex attribute bit for bit: PLY any;
+// OBJ `uv` (float32 × 2 or 3, as vt) and `normal` (float32 × 3, as vn); VTK
+// any whose name has no space; Medit `ref` and TetGen `marker` (integers, 1
+// component; read back as the narrowest type that holds their values) and
+// TetGen `attribute` (float32). (Text keeps a NaN's sign, not its payload.)
+// Writers refuse a complex with an attribute their format cannot hold
+// (InvalidArgument) rather than drop it.
+bool holdsAttribute(Format format, const VertexAttribute& attribute);
 
 struct WriteOptions {
   // PLY only: ascii instead of binary little-endian.

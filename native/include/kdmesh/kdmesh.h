@@ -42,11 +42,26 @@ constexpr int kAttributeTypeCount = 7;
 size_t attributeTypeBytes(AttributeType type);
 const char* attributeTypeName(AttributeType type);
 
+// How a stream codes a float32 attribute's values (docs/FORMAT.md). The
+// encoder chooses it from EncodeOptions (attributeBits, normalBits) and
+// ignores this field of its input; the decoder reports what the stream did.
+struct AttributeQuantization {
+  enum Kind : uint8_t {
+    Exact = 0,       // every bit
+    Uniform = 1,     // per component, value q of `bits` bits stands for minimum + q · step
+    Octahedral = 2,  // a unit vector (3 components) as two `bits`-bit octahedral coordinates
+  };
+  Kind kind = Exact;
+  uint8_t bits = 0;
+  std::array<float, 4> minimum{}, step{};  // Uniform, per component
+};
+
 struct VertexAttribute {
   std::string name;          // 1..64 printable ASCII characters, unique in a complex
   AttributeType type = AttributeType::Float32;
   uint8_t components = 1;    // 1..4
   std::vector<uint8_t> values;  // vertex count · components values, in memory order
+  AttributeQuantization quantization;
 
   size_t valueBytes() const { return attributeTypeBytes(type) * components; }  // per vertex
 };
@@ -193,6 +208,15 @@ struct EncodeOptions {
   int bits = 16;
   // Preserve every float32 coordinate bit for bit (overrides `bits`).
   bool exact = false;
+  // Float32 vertex attributes are exact unless these are set (lossy):
+  // `attributeBits` (1..24) quantizes each component of every float32
+  // attribute to that many bits over its range (the step is never below
+  // 2^-22 of the largest magnitude, where float32 values no longer differ);
+  // `normalBits` (2..16) codes a float32 × 3 attribute named `normal` as
+  // unit vectors in two octahedral coordinates of that many bits, as web
+  // codecs do (Draco, meshoptimizer). Decoding gives float32 values back.
+  int attributeBits = 0;
+  int normalBits = 0;
   // Largest chunk payload in bytes. The first chunks are smaller (1 KiB,
   // doubling up to this size) so that a viewer can show something early.
   size_t chunkBytes = 16 * 1024;

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <charconv>
 #include <cstring>
 #include <limits>
@@ -223,6 +224,73 @@ bool takeFromBudget(uint64_t count, uint64_t minBytesEach, uint64_t& budget) {
 }
 
 // ---------------------------------------------------------------------------
+// Attribute values
+// ---------------------------------------------------------------------------
+
+namespace {
+
+// The range of an integer type's values.
+void integerRange(AttributeType type, int64_t& low, int64_t& high) {
+  switch (type) {
+    case AttributeType::UInt8: low = 0, high = 0xff; break;
+    case AttributeType::Int8: low = -0x80, high = 0x7f; break;
+    case AttributeType::UInt16: low = 0, high = 0xffff; break;
+    case AttributeType::Int16: low = -0x8000, high = 0x7fff; break;
+    case AttributeType::UInt32: low = 0, high = 0xffffffffll; break;
+    default: low = -0x80000000ll, high = 0x7fffffffll; break;
+  }
+}
+
+}  // namespace
+
+bool parseAttributeValue(std::string_view token, AttributeType type, uint8_t* out) {
+  if (type == AttributeType::Float32) {
+    float value;
+    if (!parseFloat(token, value)) return false;
+    std::memcpy(out, &value, 4);
+    return true;
+  }
+  int64_t value, low, high;
+  integerRange(type, low, high);
+  if (!parseInteger(token, value) || value < low || value > high) return false;
+  const uint32_t bits = static_cast<uint32_t>(value);
+  std::memcpy(out, &bits, attributeTypeBytes(type));  // little-endian, as every target
+  return true;
+}
+
+bool narrowestIntegerType(const std::vector<int64_t>& values, AttributeType& type) {
+  int64_t least = 0, most = 0;
+  for (const int64_t v : values) least = std::min(least, v), most = std::max(most, v);
+  for (const AttributeType t : {AttributeType::UInt8, AttributeType::Int8, AttributeType::UInt16,
+                                AttributeType::Int16, AttributeType::UInt32, AttributeType::Int32}) {
+    int64_t low, high;
+    integerRange(t, low, high);
+    if (least >= low && most <= high) {
+      type = t;
+      return true;
+    }
+  }
+  return false;
+}
+
+VertexAttribute integerAttribute(std::string name, AttributeType type, const std::vector<int64_t>& values) {
+  VertexAttribute a{std::move(name), type, 1, {}, {}};
+  const size_t bytes = attributeTypeBytes(type);
+  a.values.resize(values.size() * bytes);
+  for (size_t i = 0; i < values.size(); ++i) {
+    const uint32_t bits = static_cast<uint32_t>(values[i]);
+    std::memcpy(&a.values[i * bytes], &bits, bytes);
+  }
+  return a;
+}
+
+const VertexAttribute* findAttribute(const Complex& complex, std::string_view name) {
+  for (const VertexAttribute& a : complex.attributes)
+    if (a.name == name) return &a;
+  return nullptr;
+}
+
+// ---------------------------------------------------------------------------
 // Polygons and notes
 // ---------------------------------------------------------------------------
 
@@ -239,16 +307,20 @@ void PolygonSplit::append(const uint32_t* polygon, size_t size,
 
 void PolygonSplit::addNote(Notes& notes) const {
   if (polygons == 0) return;
-  notes.push_back("split " + std::to_string(polygons) +
-                  (polygons == 1 ? " polygon" : " polygons") +
+  notes.push_back("split " + counted(polygons, "polygon", "polygons") +
                   " with more than 3 vertices into " +
-                  std::to_string(triangles) + " triangles");
+                  counted(triangles, "triangle", "triangles"));
 }
 
-void addCountNote(Notes& notes, const char* before, size_t count,
-                  const char* after) {
+std::string counted(uint64_t count, std::string_view one, std::string_view many) {
+  return std::to_string(count) + " " + std::string(count == 1 ? one : many);
+}
+
+void addCountNote(Notes& notes, std::string_view before, uint64_t count,
+                  std::string_view one, std::string_view many,
+                  std::string_view after) {
   if (count == 0) return;
-  notes.push_back(before + std::to_string(count) + after);
+  notes.push_back(std::string(before) + counted(count, one, many) + std::string(after));
 }
 
 // ---------------------------------------------------------------------------
@@ -276,6 +348,28 @@ TextOut& TextOut::integer(uint64_t value) {
   char buffer[24];
   auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
   return word(std::string_view(buffer, result.ptr - buffer));
+}
+
+TextOut& TextOut::signedInteger(int64_t value) {
+  char buffer[24];
+  auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
+  return word(std::string_view(buffer, result.ptr - buffer));
+}
+
+TextOut& TextOut::value(AttributeType type, const uint8_t* bytes) {
+  uint32_t bits = 0;
+  std::memcpy(&bits, bytes, attributeTypeBytes(type));  // little-endian, as every target
+  switch (type) {
+    case AttributeType::Float32: {
+      float f;
+      std::memcpy(&f, &bits, 4);
+      return real(f);
+    }
+    case AttributeType::Int8: return signedInteger(int8_t(bits));
+    case AttributeType::Int16: return signedInteger(int16_t(bits));
+    case AttributeType::Int32: return signedInteger(int32_t(bits));
+    default: return integer(bits);
+  }
 }
 
 TextOut& TextOut::endLine() {

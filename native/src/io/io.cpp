@@ -55,8 +55,9 @@ Status checkIndices(const std::vector<uint32_t>& indices, size_t arity,
     if (indices[i] >= vertexCount) {
       return inputError(std::string(simplexName) + " " +
                         std::to_string(i / arity) + " refers to vertex " +
-                        std::to_string(indices[i]) + ", but there are " +
-                        std::to_string(vertexCount) + " vertices");
+                        std::to_string(indices[i]) + ", but there " +
+                        (vertexCount == 1 ? "is " : "are ") +
+                        detail::counted(vertexCount, "vertex", "vertices"));
     }
   }
   return Status::success();
@@ -294,6 +295,17 @@ const char* formatName(Format format) {
   return "unknown";
 }
 
+bool holdsAttribute(Format format, const VertexAttribute& a) {
+  switch (format) {
+    case Format::Ply: return true;
+    case Format::Obj: return detail::objHoldsAttribute(a);
+    case Format::Vtk: return detail::vtkHoldsAttribute(a);
+    case Format::Medit: return detail::meditHoldsAttribute(a);
+    case Format::TetGen: return detail::tetgenHoldsAttribute(a);
+    default: return false;
+  }
+}
+
 Status readMemory(Format format, const uint8_t* data, size_t size,
                   Complex& out, Notes& notes, const ReadOptions& options) {
   out = Complex{};
@@ -323,15 +335,16 @@ Status readFile(const std::string& path, Complex& out, Notes& notes,
   return readInput(format, input, out, notes, options);
 }
 
-// Only PLY holds vertex attributes: other formats refuse a complex with
-// them rather than drop them silently.
+// A format refuses a complex with attributes it cannot hold rather than
+// drop them silently.
 Status checkAttributesWritable(Format format, const Complex& complex) {
-  if (format == Format::Ply || complex.attributes.empty()) return Status::success();
   std::string names;
-  for (const VertexAttribute& a : complex.attributes) names += (names.empty() ? "" : ", ") + a.name;
+  for (const VertexAttribute& a : complex.attributes)
+    if (!holdsAttribute(format, a)) names += (names.empty() ? "" : ", ") + a.name;
+  if (names.empty()) return Status::success();
   return Status::error(ErrorCode::InvalidArgument, std::string(formatName(format)) +
-                                                       " cannot hold vertex attributes (" + names +
-                                                       "): write PLY to keep them");
+                                                       " cannot hold the vertex attributes " + names +
+                                                       ": write PLY to keep them");
 }
 
 // Simplex labels go to PLY (a `label` property), Medit (element references)

@@ -192,6 +192,25 @@ Status lineError(size_t line, const std::string& message);
 bool takeFromBudget(uint64_t count, uint64_t minBytesEach, uint64_t& budget);
 
 // ---------------------------------------------------------------------------
+// Attribute values in text (VTK, TetGen, Medit)
+// ---------------------------------------------------------------------------
+
+// Parses `token` as one value of `type` into `out` (its bytes in memory
+// order): an integer must be whole and fit the type; a float is rounded to
+// float32 (NaN and infinities included).
+bool parseAttributeValue(std::string_view token, AttributeType type, uint8_t* out);
+
+// The narrowest integer type that holds every one of `values`, unsigned
+// before signed (uint8, int8, uint16, ...); false when no 32-bit type does.
+bool narrowestIntegerType(const std::vector<int64_t>& values, AttributeType& type);
+
+// A one-component attribute of `type` with `values`, which fit it.
+VertexAttribute integerAttribute(std::string name, AttributeType type, const std::vector<int64_t>& values);
+
+// The attribute of `complex` named `name`, or nullptr.
+const VertexAttribute* findAttribute(const Complex& complex, std::string_view name);
+
+// ---------------------------------------------------------------------------
 // Polygons
 // ---------------------------------------------------------------------------
 
@@ -206,10 +225,14 @@ struct PolygonSplit {
   void addNote(Notes& notes) const;
 };
 
-// Adds the note `before` count `after` when count > 0, as in
-// "ignored extra columns on " 12 " vertex lines".
-void addCountNote(Notes& notes, const char* before, size_t count,
-                  const char* after);
+// "1 triangle", "2 triangles": the count and the noun it agrees with.
+std::string counted(uint64_t count, std::string_view one, std::string_view many);
+
+// Adds the note `before` counted(count, one, many) `after` when count > 0,
+// as in "ignored extra columns on " 12 " vertex line(s)" "".
+void addCountNote(Notes& notes, std::string_view before, uint64_t count,
+                  std::string_view one, std::string_view many,
+                  std::string_view after = {});
 
 // ---------------------------------------------------------------------------
 // Writing text
@@ -226,6 +249,9 @@ class TextOut {
   // The three coordinates at `xyz`.
   TextOut& point(const float* xyz) { return real(xyz[0]).real(xyz[1]).real(xyz[2]); }
   TextOut& integer(uint64_t value);
+  TextOut& signedInteger(int64_t value);
+  // One attribute value of `type`, from its bytes in memory order.
+  TextOut& value(AttributeType type, const uint8_t* bytes);
   TextOut& endLine();
 
  private:
@@ -307,14 +333,25 @@ void weldVertices(Complex& complex, Notes& notes);
 Status writePly(const Complex& complex, std::vector<uint8_t>& out,
                 const WriteOptions& options);
 Status writeObj(const Complex& complex, std::vector<uint8_t>& out);
+// Whether OBJ holds the attribute: `uv` (float32 × 2 or 3), `normal`
+// (float32 × 3).
+bool objHoldsAttribute(const VertexAttribute& attribute);
 Status writeOff(const Complex& complex, std::vector<uint8_t>& out);
 Status writeXyz(const Complex& complex, std::vector<uint8_t>& out);
 Status writeMedit(const Complex& complex, std::vector<uint8_t>& out);
+// Whether Medit holds the attribute: `ref`, an integer per vertex.
+bool meditHoldsAttribute(const VertexAttribute& attribute);
 Status writeVtk(const Complex& complex, std::vector<uint8_t>& out);
+// Whether VTK holds the attribute: any whose name has no space.
+bool vtkHoldsAttribute(const VertexAttribute& attribute);
 // The .node file, after checking that the complex has nothing but vertices
 // and tetrahedra; the .ele file (which may list no tetrahedra).
 Status writeTetgenNode(const Complex& complex, std::vector<uint8_t>& out);
 Status writeTetgenEle(const Complex& complex, std::vector<uint8_t>& out);
+// Whether TetGen holds the attribute: `attribute` (float32 × 1..4, the
+// point attributes) and `marker` (an integer per vertex, the boundary
+// marker).
+bool tetgenHoldsAttribute(const VertexAttribute& attribute);
 
 // True when every listed point is a vertex used by no simplex, so a format
 // without explicit points loses nothing by dropping the list: such vertices

@@ -140,8 +140,7 @@ class MeditReader {
     }
     split_.addNote(notes);
     keepLabels(notes);
-    addCountNote(notes, "ignored the nonzero references of ", labelled_,
-                 " vertices");
+    if (Status status = keepVertexReferences(); !status.ok()) return status;
     for (const std::string& skipped : skipped_) notes.push_back(skipped);
     return Status::success();
   }
@@ -209,8 +208,8 @@ class MeditReader {
     uint64_t budget = scanner_.remainingBytes() + 1;
     if (!takeFromBudget(count, 2 * section.valuesPerItem, budget)) {
       return error(std::string(section.keyword) + " declares " +
-                   std::to_string(count) +
-                   " items, more than the rest of the file can hold");
+                   counted(count, "item", "items") +
+                   ", more than the rest of the file can hold");
     }
     switch (section.kind) {
       case Kind::Vertices: return readVertices(count);
@@ -226,6 +225,7 @@ class MeditReader {
       return error("more vertices than 32-bit indices can address");
     }
     out_.positions.reserve(3 * count);
+    vertexReferences_.reserve(count);
     for (uint64_t v = 0; v < count; ++v) {
       float xyz[3];
       for (float& value : xyz) {
@@ -242,8 +242,8 @@ class MeditReader {
       if (Status status = readReference(Kind::Vertices, v, reference); !status.ok()) {
         return status;
       }
-      labelled_ += reference != 0;
       out_.positions.insert(out_.positions.end(), xyz, xyz + 3);
+      vertexReferences_.push_back(reference);
     }
     return Status::success();
   }
@@ -341,6 +341,19 @@ class MeditReader {
     return Status::success();
   }
 
+  // The vertices' references as the attribute `ref`, of the narrowest
+  // integer type that holds them, unless all are 0.
+  Status keepVertexReferences() {
+    bool any = false;
+    for (const int64_t r : vertexReferences_) any = any || r != 0;
+    if (!any) return Status::success();
+    AttributeType type;
+    if (!narrowestIntegerType(vertexReferences_, type))
+      return inputError("vertex references beyond the 32-bit range");
+    out_.attributes.push_back(integerAttribute("ref", type, vertexReferences_));
+    return Status::success();
+  }
+
   // Sorts the first n (2 or 3) ids.
   static void sortFirst(std::array<uint32_t, 3>& ids, size_t n) {
     if (ids[0] > ids[1]) std::swap(ids[0], ids[1]);
@@ -383,8 +396,9 @@ class MeditReader {
         dropped += std::binary_search(faces.begin(), faces.end(), simplex);
       }
     }
-    addCountNote(notes, "dropped the nonzero references of ", dropped,
-                 " edges and triangles that are faces of listed triangles or tetrahedra");
+    addCountNote(notes, "dropped the nonzero references of ", dropped, "edge or triangle", "edges and triangles",
+                 dropped == 1 ? " that is a face of a listed triangle or tetrahedron"
+                              : " that are faces of listed triangles or tetrahedra");
   }
 
   TextScanner scanner_;
@@ -392,9 +406,9 @@ class MeditReader {
   bool sawVersion_ = false;
   bool sawVertices_ = false;
   bool doublePrecision_ = false;
-  size_t labelled_ = 0;  // vertices with a nonzero reference
   SimplexLabels references_;  // of the elements, one per simplex
   bool nonzeroReferences_ = false;
+  std::vector<int64_t> vertexReferences_;
   PolygonSplit split_;
   std::vector<std::string> skipped_;
 };
@@ -404,6 +418,10 @@ class MeditReader {
 Status readMedit(const uint8_t* data, size_t size, Complex& out,
                  Notes& notes) {
   return MeditReader(data, size, out).read(notes);
+}
+
+bool meditHoldsAttribute(const VertexAttribute& a) {
+  return a.name == "ref" && a.components == 1 && a.type != AttributeType::Float32;
 }
 
 Status writeMedit(const Complex& complex, std::vector<uint8_t>& out) {
@@ -418,9 +436,15 @@ Status writeMedit(const Complex& complex, std::vector<uint8_t>& out) {
   text.word("Vertices").endLine();
   text.integer(complex.vertexCount()).endLine();
   const std::vector<float>& positions = complex.positions;
-  for (size_t i = 0; i < positions.size(); i += 3) {
-    text.point(&positions[i]).integer(0)
-        .endLine();
+  const VertexAttribute* references = findAttribute(complex, "ref");
+  for (size_t v = 0; v < complex.vertexCount(); ++v) {
+    text.point(&positions[3 * v]);
+    if (references) {
+      text.value(references->type, &references->values[v * references->valueBytes()]);
+    } else {
+      text.integer(0);
+    }
+    text.endLine();
   }
   const struct {
     const char* keyword;

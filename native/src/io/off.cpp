@@ -58,9 +58,9 @@ Status readCounts(TextScanner& scanner, uint64_t& vertices, uint64_t& faces) {
 }
 
 Status endsEarly(size_t line, uint64_t read, uint64_t expected,
-                 const char* what) {
+                 const char* one, const char* many) {
   return lineError(line, "the file ends after " + std::to_string(read) +
-                             " of " + std::to_string(expected) + " " + what);
+                             " of " + counted(expected, one, many));
 }
 
 // Reads the polygon on the current line into `polygon`; sets `extraValues`
@@ -125,7 +125,7 @@ Status readOff(const uint8_t* data, size_t size, Complex& out, Notes& notes) {
   size_t extraVertexColumns = 0;
   for (uint64_t v = 0; v < vertexCount; ++v) {
     if (!scanner.nextContentLine()) {
-      return endsEarly(scanner.lineNumber(), v, vertexCount, "vertices");
+      return endsEarly(scanner.lineNumber(), v, vertexCount, "vertex", "vertices");
     }
     bool extraColumns = false;
     Status status = readPositionLine(scanner, out.positions, extraColumns);
@@ -138,7 +138,7 @@ Status readOff(const uint8_t* data, size_t size, Complex& out, Notes& notes) {
   size_t facesWithColour = 0;
   for (uint64_t f = 0; f < faceCount; ++f) {
     if (!scanner.nextContentLine()) {
-      return endsEarly(scanner.lineNumber(), f, faceCount, "faces");
+      return endsEarly(scanner.lineNumber(), f, faceCount, "face", "faces");
     }
     bool extraValues = false;
     Status status = readFace(scanner, f, vertexCount, polygon, extraValues);
@@ -154,16 +154,16 @@ Status readOff(const uint8_t* data, size_t size, Complex& out, Notes& notes) {
     if (extraLines++ == 0) firstExtraLine = scanner.lineNumber();
   }
   if (extraLines > 0) {
-    notes.push_back("ignored " + std::to_string(extraLines) +
-                    " lines after the " + std::to_string(faceCount) +
-                    " faces that the header declares (the first: line " +
+    notes.push_back("ignored " + counted(extraLines, "line", "lines") +
+                    " after the " + counted(faceCount, "face", "faces") +
+                    " that the header declares (the first: line " +
                     std::to_string(firstExtraLine) + ")");
   }
   addCountNote(notes,
                "ignored extra vertex columns (colour, normal or texture "
                "coordinates) on ",
-               extraVertexColumns, " vertices");
-  addCountNote(notes, "ignored colour values on ", facesWithColour, " faces");
+               extraVertexColumns, "vertex", "vertices");
+  addCountNote(notes, "ignored colour values on ", facesWithColour, "face", "faces");
   split.addNote(notes);
   return Status::success();
 }

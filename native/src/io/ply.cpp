@@ -643,7 +643,7 @@ bool readIndexList(Values& values, const PlyProperty& property,
   if (length < 0 || static_cast<uint64_t>(length) < plan.listMin ||
       static_cast<uint64_t>(length) > plan.listMax) {
     return values.fail(
-        "has " + std::to_string(length) + " vertices, " +
+        "has " + counted(uint64_t(length), "vertex", "vertices") + ", " +
         (plan.listMin == plan.listMax ? "needs exactly " : "needs at least ") +
         std::to_string(plan.listMin));
   }
@@ -918,10 +918,10 @@ Status readPly(Input& input, Complex& out, Notes& notes) {
   for (int d = 1; d <= 3; ++d)
     if (!out.labels.of(d).empty()) out.labels.of(d).resize(out.simplexCount(d), 0);
   state.split.addNote(notes);
-  addCountNote(notes, "ignored ", trailingBytes,
-               " bytes after the last PLY element");
-  addCountNote(notes, "ignored ", trailingValues,
-               " values after the last PLY element");
+  addCountNote(notes, "ignored ", trailingBytes, "byte", "bytes",
+               " after the last PLY element");
+  addCountNote(notes, "ignored ", trailingValues, "value", "values",
+               " after the last PLY element");
   return Status::success();
 }
 
@@ -993,22 +993,7 @@ class TextSink {
  public:
   explicit TextSink(std::vector<uint8_t>& out) : text_(out) {}
   void coordinate(float value) { text_.real(value); }
-  void attribute(AttributeType type, const uint8_t* value) {
-    uint32_t bits = 0;
-    std::memcpy(&bits, value, attributeTypeBytes(type));
-    switch (type) {
-      case AttributeType::Float32: {
-        float f;
-        std::memcpy(&f, &bits, 4);
-        text_.real(f);
-        break;
-      }
-      case AttributeType::Int8: text_.word(std::to_string(int8_t(bits))); break;
-      case AttributeType::Int16: text_.word(std::to_string(int16_t(bits))); break;
-      case AttributeType::Int32: text_.word(std::to_string(int32_t(bits))); break;
-      default: text_.integer(bits); break;
-    }
-  }
+  void attribute(AttributeType type, const uint8_t* value) { text_.value(type, value); }
   void listLength(uint8_t length) { text_.integer(length); }
   void index(uint32_t value) { text_.integer(value); }
   void label(int32_t value) { text_.word(std::to_string(value)); }

@@ -132,8 +132,8 @@ Status readBinaryCount(Bytes head, uint64_t size, uint64_t& count) {
 // The facet normals are not kept (every viewer recomputes them from the
 // corners): a note counts the facets that gave one.
 void addFacetNormalNote(Notes& notes, size_t withNormal) {
-  addCountNote(notes, "ignored the facet normals of ", withNormal,
-               " triangles (kdmesh keeps the corners; normals follow from them)");
+  addCountNote(notes, "ignored the facet normals of ", withNormal, "triangle", "triangles",
+               " (kdmesh keeps the corners; normals follow from them)");
 }
 
 Status readBinary(Input& input, uint64_t size, Complex& out, Notes& notes,
@@ -169,9 +169,9 @@ Status readBinary(Input& input, uint64_t size, Complex& out, Notes& notes,
   }
   addFacetNormalNote(notes, withNormal);
   addCountNote(notes, "ignored the attribute values (often a colour) of ",
-               withAttribute, " triangles");
-  addCountNote(notes, "ignored ", bytes.remaining(),
-               " bytes after the triangles of the binary STL");
+               withAttribute, "triangle", "triangles");
+  addCountNote(notes, "ignored ", bytes.remaining(), "byte", "bytes",
+               " after the triangles of the binary STL");
   soup.addNotes(notes);
   return Status::success();
 }

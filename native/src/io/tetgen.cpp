@@ -9,6 +9,7 @@
 // the .ele file uses the same numbering. A 10-node tetrahedron lists its 4
 // corners first; the other 6 nodes are mid-edge points and stay vertices
 // without simplices. Node order is kept as is, so the orientation survives.
+#include <algorithm>
 #include <cmath>
 #include <limits>
 
@@ -94,24 +95,24 @@ Status skipColumns(TextScanner& scanner, const char* what, uint64_t item,
 }
 
 void noteTrailingLines(TextScanner& scanner, const char* file, uint64_t count,
-                       const char* what, Notes& notes) {
+                       const char* one, const char* many, Notes& notes) {
   size_t extraLines = 0, firstExtraLine = 0;
   while (scanner.nextContentLine()) {
     if (extraLines++ == 0) firstExtraLine = scanner.lineNumber();
   }
   if (extraLines > 0) {
-    notes.push_back("ignored " + std::to_string(extraLines) + " lines of the " +
-                    file + " file after the " + std::to_string(count) + " " +
-                    what + " that its header declares (the first: line " +
+    notes.push_back("ignored " + counted(extraLines, "line", "lines") + " of the " +
+                    file + " file after the " + counted(count, one, many) +
+                    " that its header declares (the first: line " +
                     std::to_string(firstExtraLine) + ")");
   }
 }
 
 Status endsEarly(const TextScanner& scanner, uint64_t read, uint64_t expected,
-                 const char* what) {
+                 const char* one, const char* many) {
   return lineError(scanner.lineNumber(),
                    "the file ends after " + std::to_string(read) + " of " +
-                       std::to_string(expected) + " " + what);
+                       counted(expected, one, many));
 }
 
 }  // namespace
@@ -154,11 +155,23 @@ Status readTetgenNode(const uint8_t* data, size_t size, Complex& out,
                          "hold");
   }
   out.positions.reserve(3 * count);
+  // The point attributes in attributes of up to 4 components, as many as
+  // a stream holds; the markers, typed once all are read.
+  const uint64_t kept = std::min<uint64_t>(attributes, 4 * (kMaxAttributes - 1));
+  std::vector<VertexAttribute> pointAttributes;
+  for (uint64_t first = 0; first < kept; first += 4) {
+    VertexAttribute a{kept <= 4 ? "attribute" : "attribute_" + std::to_string(first), AttributeType::Float32,
+                      uint8_t(std::min<uint64_t>(4, kept - first)), {}, {}};
+    a.values.reserve(count * a.valueBytes());
+    pointAttributes.push_back(std::move(a));
+  }
+  std::vector<int64_t> markerValues;
+  markerValues.reserve(markers ? count : 0);
   int64_t base = 0;
   size_t extraLines = 0;
   for (uint64_t p = 0; p < count; ++p) {
     if (!scanner.nextContentLine()) {
-      return endsEarly(scanner, p, count, "points");
+      return endsEarly(scanner, p, count, "point", "points");
     }
     if (Status status = readItemNumber(scanner, "point", p, base);
         !status.ok()) {
@@ -179,22 +192,51 @@ Status readTetgenNode(const uint8_t* data, size_t size, Complex& out,
       }
       out.positions.push_back(value);
     }
-    if (Status status = skipColumns(scanner, "point", p, attributes + markers,
-                                    extraLines);
-        !status.ok()) {
-      return status;
+    for (uint64_t i = 0; i < attributes + markers; ++i) {
+      std::string_view token;
+      if (!scanner.nextToken(token)) {
+        return lineError(scanner.lineNumber(),
+                         "point " + std::to_string(p) + " lacks " +
+                             std::to_string(attributes + markers - i) +
+                             " of the attribute or marker values the header declares");
+      }
+      bool ok = true;
+      if (i >= attributes) {
+        int64_t marker;
+        ok = parseInteger(token, marker);
+        markerValues.push_back(marker);
+      } else if (i < kept) {
+        float value;
+        ok = parseFloat(token, value);
+        std::vector<uint8_t>& values = pointAttributes[size_t(i / 4)].values;
+        const auto* bytes = reinterpret_cast<const uint8_t*>(&value);
+        values.insert(values.end(), bytes, bytes + 4);
+      }
+      if (!ok) {
+        return lineError(scanner.lineNumber(),
+                         "point " + std::to_string(p) + ": " + quoted(token) + " is not " +
+                             (i >= attributes ? "an integer boundary marker" : "a number"));
+      }
     }
+    std::string_view token;
+    extraLines += scanner.nextToken(token);
   }
   firstIndex = static_cast<uint32_t>(base);
-  noteTrailingLines(scanner, ".node", count, "points", notes);
-  if (attributes > 0 || markers > 0) {
-    notes.push_back("ignored the " + std::to_string(attributes) +
-                    " attributes" +
-                    (markers ? " and the boundary marker" : "") +
-                    " of every .node point");
+  noteTrailingLines(scanner, ".node", count, "point", "points", notes);
+  for (VertexAttribute& a : pointAttributes) out.attributes.push_back(std::move(a));
+  if (markers) {
+    AttributeType type;
+    if (!narrowestIntegerType(markerValues, type))
+      return inputError("TetGen .node boundary markers beyond the 32-bit range");
+    out.attributes.push_back(integerAttribute("marker", type, markerValues));
+  }
+  if (kept < attributes) {
+    notes.push_back("ignored " + std::to_string(attributes - kept) + " of the " + std::to_string(attributes) +
+                    " attributes of every .node point (a stream holds " + std::to_string(kMaxAttributes) +
+                    " attributes)");
   }
   addCountNote(notes, "ignored extra values on ", extraLines,
-               " .node point lines");
+               ".node point line", ".node point lines");
   return Status::success();
 }
 
@@ -227,7 +269,7 @@ Status readTetgenEle(const uint8_t* data, size_t size, uint32_t firstIndex,
   size_t extraLines = 0;
   for (uint64_t t = 0; t < count; ++t) {
     if (!scanner.nextContentLine()) {
-      return endsEarly(scanner, t, count, "tetrahedra");
+      return endsEarly(scanner, t, count, "tetrahedron", "tetrahedra");
     }
     if (Status status = readItemNumber(scanner, "tetrahedron", t, base);
         !status.ok()) {
@@ -287,7 +329,7 @@ Status readTetgenEle(const uint8_t* data, size_t size, uint32_t firstIndex,
     }
     out.tetrahedra.insert(out.tetrahedra.end(), corners, corners + 4);
   }
-  noteTrailingLines(scanner, ".ele", count, "tetrahedra", notes);
+  noteTrailingLines(scanner, ".ele", count, "tetrahedron", "tetrahedra", notes);
   if (nodes == 10 && count > 0) {
     notes.push_back("kept the 4 corners of " + std::to_string(count) +
                     " 10-node tetrahedra; their mid-edge nodes are vertices "
@@ -298,8 +340,13 @@ Status readTetgenEle(const uint8_t* data, size_t size, uint32_t firstIndex,
                     std::to_string(attributes - 1));
   }
   addCountNote(notes, "ignored extra values on ", extraLines,
-               " .ele tetrahedron lines");
+               ".ele tetrahedron line", ".ele tetrahedron lines");
   return Status::success();
+}
+
+bool tetgenHoldsAttribute(const VertexAttribute& a) {
+  return (a.name == "attribute" && a.type == AttributeType::Float32) ||
+         (a.name == "marker" && a.components == 1 && a.type != AttributeType::Float32);
 }
 
 Status writeTetgenNode(const Complex& complex, std::vector<uint8_t>& out) {
@@ -314,18 +361,24 @@ Status writeTetgenNode(const Complex& complex, std::vector<uint8_t>& out) {
                          "TetGen cannot hold explicit points on vertices "
                          "that tetrahedra use");
   }
+  const VertexAttribute* values = findAttribute(complex, "attribute");
+  const VertexAttribute* marker = findAttribute(complex, "marker");
   TextOut text(out);
   text.word("# written by kdmesh").endLine();
   text.integer(complex.vertexCount())
       .integer(3)
-      .integer(0)
-      .integer(0)
+      .integer(values ? values->components : 0)
+      .integer(marker ? 1 : 0)
       .endLine();
   const std::vector<float>& positions = complex.positions;
   for (size_t v = 0; v < complex.vertexCount(); ++v) {
     text.integer(v + 1)  // numbered from 1, as TetGen writes by default
-        .point(&positions[3 * v])
-        .endLine();
+        .point(&positions[3 * v]);
+    if (values)
+      for (size_t k = 0; k < values->components; ++k)
+        text.value(AttributeType::Float32, &values->values[(v * values->components + k) * 4]);
+    if (marker) text.value(marker->type, &marker->values[v * marker->valueBytes()]);
+    text.endLine();
   }
   return Status::success();
 }

@@ -11,8 +11,11 @@
 // Version 5 files may give the cells as "CELLS offsets connectivity" followed
 // by OFFSETS and CONNECTIVITY arrays; both layouts are read. POLYDATA (with
 // VERTICES, LINES, POLYGONS and TRIANGLE_STRIPS) is read too. Keywords are
-// case-insensitive. FIELD data and METADATA blocks are skipped; POINT_DATA or
-// CELL_DATA ends the reading, as the rest only holds attributes.
+// case-insensitive. METADATA blocks are skipped. After POINT_DATA n, the
+// arrays of 1 to 4 components (SCALARS, COLOR_SCALARS, VECTORS, NORMALS,
+// TEXTURE_COORDINATES, GLOBAL_IDS, PEDIGREE_IDS and FIELD arrays of n
+// tuples) become vertex attributes; CELL_DATA arrays, TENSORS, lookup
+// tables and FIELD data of the dataset are skipped and counted.
 #include <limits>
 #include <map>
 
@@ -82,6 +85,43 @@ class Tokens {
   size_t previousLine_ = 0;
 };
 
+// The attribute type of a VTK data type: integers of up to 32 bits as
+// themselves, float as float32; `rounded` for double (rounded to float32),
+// `wide` for 64-bit integers (whose values choose a type).
+AttributeType attributeTypeOf(std::string_view name, bool& rounded, bool& wide) {
+  rounded = wide = false;
+  const auto is = [name](std::initializer_list<std::string_view> names) {
+    for (std::string_view n : names)
+      if (equalsIgnoringCase(name, n)) return true;
+    return false;
+  };
+  if (is({"bit", "unsigned_char", "vtktypeuint8"})) return AttributeType::UInt8;
+  if (is({"char", "vtktypeint8"})) return AttributeType::Int8;
+  if (is({"unsigned_short", "vtktypeuint16"})) return AttributeType::UInt16;
+  if (is({"short", "vtktypeint16"})) return AttributeType::Int16;
+  if (is({"unsigned_int", "vtktypeuint32"})) return AttributeType::UInt32;
+  if (is({"int", "vtktypeint32"})) return AttributeType::Int32;
+  if (is({"float", "vtktypefloat32"})) return AttributeType::Float32;
+  if (is({"double", "vtktypefloat64"})) {
+    rounded = true;
+    return AttributeType::Float32;
+  }
+  wide = true;  // long, unsigned_long, vtkIdType, vtktype(u)int64
+  return AttributeType::Int32;
+}
+
+const char* vtkTypeName(AttributeType type) {
+  switch (type) {
+    case AttributeType::UInt8: return "unsigned_char";
+    case AttributeType::Int8: return "char";
+    case AttributeType::UInt16: return "unsigned_short";
+    case AttributeType::Int16: return "short";
+    case AttributeType::UInt32: return "unsigned_int";
+    case AttributeType::Int32: return "int";
+    default: return "float";
+  }
+}
+
 bool isDataType(std::string_view name) {
   for (std::string_view type :
        {"bit", "char", "unsigned_char", "short", "unsigned_short", "int",
@@ -130,15 +170,14 @@ class VtkReader {
       if (equalsIgnoringCase(keyword, "DATASET")) {
         status = readDataset();
       } else if (equalsIgnoringCase(keyword, "FIELD")) {
-        status = skipField();
+        status = readField();
       } else if (equalsIgnoringCase(keyword, "METADATA")) {
         tokens_.skipToBlankLine();
       } else if (equalsIgnoringCase(keyword, "POINT_DATA") ||
                  equalsIgnoringCase(keyword, "CELL_DATA")) {
-        notes.push_back("ignored " + std::string(keyword) +
-                        " and everything after it (from line " +
-                        std::to_string(tokens_.line()) + ")");
-        break;
+        status = startData(keyword);
+      } else if (data_ != Data::None && isDataSection(keyword)) {
+        status = readDataSection(keyword);
       } else if (!dataset_) {
         status = error("expected DATASET, found " + quoted(keyword));
       } else if (equalsIgnoringCase(keyword, "POINTS")) {
@@ -167,6 +206,206 @@ class VtkReader {
  private:
   Status error(const std::string& message) const {
     return lineError(tokens_.line(), message);
+  }
+
+  // Where the arrays being read belong: the dataset (FIELD before
+  // POINT_DATA), its points or its cells.
+  enum class Data { None, Points, Cells };
+
+  Status startData(std::string_view keyword) {
+    const bool points = equalsIgnoringCase(keyword, "POINT_DATA");
+    uint64_t count = 0;
+    if (Status status = readCount(points ? "POINT_DATA count" : "CELL_DATA count", count); !status.ok())
+      return status;
+    if (points) {
+      if (!havePoints_) return error("POINT_DATA comes before POINTS");
+      if (count != out_.vertexCount())
+        return error("POINT_DATA gives values for " + counted(count, "point", "points") + ", the file has " +
+                     std::to_string(out_.vertexCount()));
+    }
+    data_ = points ? Data::Points : Data::Cells;
+    tuples_ = count;
+    return Status::success();
+  }
+
+  static bool isDataSection(std::string_view keyword) {
+    for (std::string_view k : {"SCALARS", "COLOR_SCALARS", "VECTORS", "NORMALS", "TEXTURE_COORDINATES", "TENSORS",
+                               "LOOKUP_TABLE", "GLOBAL_IDS", "PEDIGREE_IDS"})
+      if (equalsIgnoringCase(keyword, k)) return true;
+    return false;
+  }
+
+  // The token after a section's keyword that names its array.
+  Status readName(std::string_view keyword, std::string_view& name) {
+    if (!tokens_.next(name)) return error("the file ends after " + std::string(keyword));
+    return Status::success();
+  }
+
+  // One array of a POINT_DATA or CELL_DATA section, up to its values.
+  Status readDataSection(std::string_view keyword) {
+    std::string_view name, type = "float";
+    uint64_t components = 1, tuples = tuples_;
+    std::string attributeName;
+    bool colour = false;
+    if (Status status = readName(keyword, name); !status.ok()) return status;
+    const std::string what(keyword);
+    if (equalsIgnoringCase(keyword, "SCALARS")) {
+      if (Status status = readDataType("SCALARS", type); !status.ok()) return status;
+      // The optional component count ends the SCALARS line.
+      const size_t line = tokens_.line();
+      std::string_view token;
+      if (tokens_.next(token)) {
+        if (tokens_.line() != line || !parseCount(token, components)) tokens_.putBack(token), components = 1;
+      }
+      if (tokens_.next(token)) {  // the lookup table, optional in practice
+        if (equalsIgnoringCase(token, "LOOKUP_TABLE")) {
+          if (!tokens_.next(token)) return error("the file ends after LOOKUP_TABLE");
+        } else {
+          tokens_.putBack(token);
+        }
+      }
+    } else if (equalsIgnoringCase(keyword, "COLOR_SCALARS")) {
+      if (Status status = readCount("COLOR_SCALARS component count", components); !status.ok()) return status;
+      colour = true;
+      attributeName = "color";
+    } else if (equalsIgnoringCase(keyword, "VECTORS") || equalsIgnoringCase(keyword, "NORMALS")) {
+      if (Status status = readDataType(what.c_str(), type); !status.ok()) return status;
+      components = 3;
+      if (equalsIgnoringCase(keyword, "NORMALS")) attributeName = "normal";
+    } else if (equalsIgnoringCase(keyword, "TEXTURE_COORDINATES")) {
+      if (Status status = readCount("TEXTURE_COORDINATES dimension", components); !status.ok()) return status;
+      if (Status status = readDataType(what.c_str(), type); !status.ok()) return status;
+      attributeName = "uv";
+    } else if (equalsIgnoringCase(keyword, "TENSORS")) {
+      if (Status status = readDataType(what.c_str(), type); !status.ok()) return status;
+      components = 9;
+    } else if (equalsIgnoringCase(keyword, "LOOKUP_TABLE")) {  // its own section: RGBA entries
+      if (Status status = readCount("LOOKUP_TABLE size", tuples); !status.ok()) return status;
+      components = 4;
+    } else {  // GLOBAL_IDS, PEDIGREE_IDS
+      if (Status status = readDataType(what.c_str(), type); !status.ok()) return status;
+    }
+    if (attributeName.empty()) attributeName = std::string(name);
+    const bool keep = data_ == Data::Points && !equalsIgnoringCase(keyword, "LOOKUP_TABLE") &&
+                      !equalsIgnoringCase(keyword, "TENSORS");
+    return readArray(what, keep ? attributeName : std::string(), type, components, tuples, colour);
+  }
+
+  // FIELD name arrays, then per array "name components tuples type" and its
+  // values; NULL_ARRAY stands for an empty one. In POINT_DATA, arrays of
+  // one value per point become attributes.
+  Status readField() {
+    std::string_view name, token;
+    uint64_t arrays = 0;
+    if (!tokens_.next(name)) return error("the file ends after FIELD");
+    if (Status status = readCount("FIELD array count", arrays); !status.ok()) {
+      return status;
+    }
+    for (uint64_t a = 0; a < arrays; ++a) {
+      if (!tokens_.next(token)) return error("the file ends inside FIELD");
+      if (equalsIgnoringCase(token, "METADATA")) {
+        tokens_.skipToBlankLine();
+        --a;
+        continue;
+      }
+      if (token == "NULL_ARRAY") continue;
+      const std::string arrayName(token);
+      uint64_t components = 0, tuples = 0;
+      std::string_view type;
+      if (Status status = readCount("FIELD component count", components);
+          !status.ok()) {
+        return status;
+      }
+      if (Status status = readCount("FIELD tuple count", tuples);
+          !status.ok()) {
+        return status;
+      }
+      if (!tokens_.next(type)) return error("the file ends inside FIELD");
+      if (equalsIgnoringCase(type, "string")) {
+        return error("FIELD arrays of strings are not supported");
+      }
+      if (!isDataType(type)) {
+        return error("FIELD: unknown data type " + quoted(type));
+      }
+      const bool keep = data_ == Data::Points && tuples == tuples_;
+      if (Status status = readArray("FIELD array", keep ? arrayName : std::string(), type, components, tuples, false);
+          !status.ok())
+        return status;
+    }
+    if (data_ == Data::None) ++fields_;
+    return Status::success();
+  }
+
+  // The values of an array of `tuples` x `components`: kept as the
+  // attribute `name` when it is not empty and the attribute can be one,
+  // else skipped and counted. COLOR_SCALARS (`colour`) hold values in
+  // 0..1 that VTK stores as bytes: kept as uint8, 255 x value rounded.
+  Status readArray(const std::string& keyword, std::string name, std::string_view typeName, uint64_t components,
+                   uint64_t tuples, bool colour) {
+    const uint64_t limit = tokens_.remainingBytes() + 1;
+    if (components != 0 && tuples > limit / components) {
+      return error(keyword + " declares " + std::to_string(components) + " x " + std::to_string(tuples) +
+                   " values, more than the rest of the file can hold");
+    }
+    const uint64_t count = components * tuples;
+    if (Status status = checkBudget(keyword.c_str(), count); !status.ok()) return status;
+    bool rounded = false, wide = false;
+    const AttributeType type = colour ? AttributeType::UInt8 : attributeTypeOf(typeName, rounded, wide);
+    if (!name.empty() && !attributeFits(name, components)) name.clear();
+    if (name.empty()) {
+      if (data_ != Data::None) ++skippedArrays_;  // the dataset's FIELD data is noted as a whole
+      std::string_view token;
+      for (uint64_t i = 0; i < count; ++i)
+        if (!tokens_.next(token)) return error("the file ends inside " + keyword);
+      return Status::success();
+    }
+    VertexAttribute a{name, type, uint8_t(components), {}, {}};
+    std::vector<int64_t> integers;  // 64-bit values, typed when all are read
+    a.values.resize(wide ? 0 : size_t(count) * attributeTypeBytes(type));
+    std::string_view token;
+    for (uint64_t i = 0; i < count; ++i) {
+      if (!tokens_.next(token)) return error("the file ends inside " + keyword + " " + quoted(name));
+      bool ok;
+      if (colour) {
+        float value;
+        ok = parseFloat(token, value) && value >= 0 && value <= 1;
+        if (ok) a.values[size_t(i)] = uint8_t(value * 255.f + 0.5f);
+      } else if (wide) {
+        int64_t value;
+        ok = parseInteger(token, value);
+        integers.push_back(value);
+      } else {
+        ok = parseAttributeValue(token, type, &a.values[size_t(i) * attributeTypeBytes(type)]);
+      }
+      if (!ok)
+        return error(keyword + " " + quoted(name) + " value " + std::to_string(i) + ": " + quoted(token) +
+                     (colour ? " is not a number from 0 to 1" : " is not a " + std::string(typeName) + " value"));
+    }
+    if (wide) {
+      AttributeType narrow;
+      if (!narrowestIntegerType(integers, narrow)) {
+        ++skippedArrays_;
+        return Status::success();
+      }
+      a.type = narrow;  // the bytes of the values in order, whatever the components
+      a.values = integerAttribute(name, narrow, integers).values;
+    }
+    roundedArrays_ += rounded;
+    out_.attributes.push_back(std::move(a));
+    return Status::success();
+  }
+
+  // Whether an array can become an attribute: 1 to 4 components, a name of
+  // printable ASCII no other attribute has, room for one more.
+  bool attributeFits(const std::string& name, uint64_t components) const {
+    if (components < 1 || components > 4 || name.size() > kMaxAttributeNameBytes ||
+        out_.attributes.size() == kMaxAttributes)
+      return false;
+    for (const char c : name)
+      if (c < 0x20 || c > 0x7e) return false;
+    for (const VertexAttribute& a : out_.attributes)
+      if (a.name == name) return false;
+    return true;
   }
 
   Status readPreamble() {
@@ -537,58 +776,6 @@ class VtkReader {
     return Status::success();
   }
 
-  // FIELD name arrays, then per array "name components tuples type" and its
-  // values; NULL_ARRAY stands for an empty one.
-  Status skipField() {
-    std::string_view name, token;
-    uint64_t arrays = 0;
-    if (!tokens_.next(name)) return error("the file ends after FIELD");
-    if (Status status = readCount("FIELD array count", arrays); !status.ok()) {
-      return status;
-    }
-    for (uint64_t a = 0; a < arrays; ++a) {
-      if (!tokens_.next(token)) return error("the file ends inside FIELD");
-      if (equalsIgnoringCase(token, "METADATA")) {
-        tokens_.skipToBlankLine();
-        --a;
-        continue;
-      }
-      if (token == "NULL_ARRAY") continue;
-      uint64_t components = 0, tuples = 0;
-      std::string_view type;
-      if (Status status = readCount("FIELD component count", components);
-          !status.ok()) {
-        return status;
-      }
-      if (Status status = readCount("FIELD tuple count", tuples);
-          !status.ok()) {
-        return status;
-      }
-      if (!tokens_.next(type)) return error("the file ends inside FIELD");
-      if (equalsIgnoringCase(type, "string")) {
-        return error("FIELD arrays of strings are not supported");
-      }
-      if (!isDataType(type)) {
-        return error("FIELD: unknown data type " + quoted(type));
-      }
-      const uint64_t limit = tokens_.remainingBytes() + 1;
-      if (components != 0 && tuples > limit / components) {
-        return error("FIELD array declares " + std::to_string(components) +
-                     " x " + std::to_string(tuples) +
-                     " values, more than the rest of the file can hold");
-      }
-      const uint64_t values = components * tuples;
-      if (Status status = checkBudget("FIELD array", values); !status.ok()) {
-        return status;
-      }
-      for (uint64_t i = 0; i < values; ++i) {
-        if (!tokens_.next(token)) return error("the file ends inside FIELD");
-      }
-    }
-    ++fields_;
-    return Status::success();
-  }
-
   // The note names a few skipped types; a file cannot make it (or the
   // map) grow with a new type in every cell.
   void countSkipped(int64_t type) {
@@ -619,11 +806,15 @@ class VtkReader {
       if (skippedOthers_ > 0) {
         types += ", other types x" + std::to_string(skippedOthers_);
       }
-      notes.push_back("skipped " + std::to_string(total) +
-                      " cells that are neither simplices nor polygons (VTK "
+      notes.push_back("skipped " + counted(total, "cell that is", "cells that are") +
+                      " neither simplices nor polygons (VTK "
                       "cell types " + types + ")");
     }
-    addCountNote(notes, "ignored ", fields_, " FIELD data sections");
+    addCountNote(notes, "ignored ", fields_, "FIELD data section", "FIELD data sections", " of the dataset");
+    addCountNote(notes, "ignored ", skippedArrays_, "data array", "data arrays",
+                 " (cell data, tensors, lookup tables, arrays of more than 4 components or of 64-bit values beyond "
+                 "32 bits, repeated names, or past 15 attributes)");
+    addCountNote(notes, "rounded the values of ", roundedArrays_, "double array", "double arrays", " to float32");
   }
 
   TextScanner scanner_;
@@ -639,6 +830,10 @@ class VtkReader {
   std::map<int64_t, size_t> skippedTypes_;  // at most 16 types named
   size_t skippedOthers_ = 0;                // cells of further types
   size_t fields_ = 0;
+  Data data_ = Data::None;
+  uint64_t tuples_ = 0;          // of the current POINT_DATA or CELL_DATA
+  size_t skippedArrays_ = 0;
+  size_t roundedArrays_ = 0;
 };
 
 }  // namespace
@@ -650,6 +845,13 @@ Status checkVtkSignature(const uint8_t* head, size_t size) {
 
 Status readVtk(const uint8_t* data, size_t size, Complex& out, Notes& notes) {
   return VtkReader(data, size, out).read(notes);
+}
+
+bool vtkHoldsAttribute(const VertexAttribute& a) {
+  // A VTK array name is one token.
+  for (const char c : a.name)
+    if (c == ' ') return false;
+  return true;
 }
 
 Status writeVtk(const Complex& complex, std::vector<uint8_t>& out) {
@@ -691,6 +893,37 @@ Status writeVtk(const Complex& complex, std::vector<uint8_t>& out) {
   for (const auto& group : groups) {
     for (size_t i = 0; i < group.indices.size(); i += group.arity) {
       text.integer(static_cast<uint64_t>(group.type)).endLine();
+    }
+  }
+  if (complex.attributes.empty()) return Status::success();
+  // The attributes as the reader takes them back: normal, uv and color
+  // (uint8, as COLOR_SCALARS in 0..1) under their own keywords, the others
+  // as SCALARS of their type.
+  text.word("POINT_DATA").integer(complex.vertexCount()).endLine();
+  for (const VertexAttribute& a : complex.attributes) {
+    const bool colour = a.name == "color" && a.type == AttributeType::UInt8;
+    const bool floats = a.type == AttributeType::Float32;
+    if (colour) {
+      text.word("COLOR_SCALARS").word(a.name).integer(a.components).endLine();
+    } else if (a.name == "normal" && floats && a.components == 3) {
+      text.word("NORMALS").word(a.name).word("float").endLine();
+    } else if (a.name == "uv" && floats && a.components <= 3) {
+      text.word("TEXTURE_COORDINATES").word(a.name).integer(a.components).word("float").endLine();
+    } else {
+      text.word("SCALARS").word(a.name).word(vtkTypeName(a.type)).integer(a.components).endLine();
+      text.word("LOOKUP_TABLE default").endLine();
+    }
+    const size_t bytes = attributeTypeBytes(a.type);
+    for (size_t v = 0; v < complex.vertexCount(); ++v) {
+      for (size_t k = 0; k < a.components; ++k) {
+        const uint8_t* value = &a.values[(v * a.components + k) * bytes];
+        if (colour) {
+          text.real(float(*value) / 255.f);
+        } else {
+          text.value(a.type, value);
+        }
+      }
+      text.endLine();
     }
   }
   return Status::success();

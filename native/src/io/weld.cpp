@@ -126,13 +126,12 @@ size_t dropRepeated(std::vector<uint32_t>& indices, size_t arity,
 
 void addWeldNotes(Notes& notes, size_t before, size_t after, size_t dropped) {
   if (after < before) {
-    notes.push_back("welded " + std::to_string(before - after) +
-                    " vertices with bit-identical positions into others (" +
-                    std::to_string(before) + " -> " + std::to_string(after) +
-                    " vertices)");
+    notes.push_back("welded " + counted(before - after, "vertex", "vertices") +
+                    " with bit-identical positions into others (" +
+                    std::to_string(before) + " -> " + counted(after, "vertex", "vertices") + ")");
   }
-  addCountNote(notes, "dropped ", dropped,
-               " simplices that welding left with a repeated vertex");
+  addCountNote(notes, "dropped ", dropped, "simplex", "simplices",
+               " that welding left with a repeated vertex");
 }
 
 namespace {

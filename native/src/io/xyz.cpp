@@ -15,7 +15,7 @@ Status readXyz(const uint8_t* data, size_t size, Complex& out, Notes& notes) {
     extraColumnLines += extraColumns;
   }
   addCountNote(notes, "ignored extra columns on ", extraColumnLines,
-               " lines");
+               "line", "lines");
   return Status::success();
 }
 
