@@ -81,20 +81,6 @@ double secondsSince(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-bool readBytes(const std::string& path, std::vector<uint8_t>& bytes, std::string& error) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    error = "cannot open " + path;
-    return false;
-  }
-  bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  if (in.bad()) {
-    error = "cannot read " + path;
-    return false;
-  }
-  return true;
-}
-
 bool writeBytes(const std::string& path, const std::vector<uint8_t>& bytes, std::string& error) {
   std::ofstream out(path, std::ios::binary);
   out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
@@ -314,8 +300,7 @@ int runDecodeGltf(const DecodeArgs& args) {
 int runDecode(const DecodeArgs& args) {
   if (kdmesh::gltf::isGltfPath(args.input)) return runDecodeGltf(args);
   std::vector<uint8_t> bytes;
-  std::string error;
-  if (!readBytes(args.input, bytes, error)) return fail(error);
+  if (auto s = kdmesh::io::readBytes(args.input, bytes); !s.ok()) return fail(s, args.input);
   const bool prefix = args.bytes > 0 && args.bytes < bytes.size();
   if (prefix) bytes.resize(size_t(args.bytes));
   kdmesh::Complex complex;
@@ -405,8 +390,7 @@ size_t distinctLabels(const kdmesh::Complex& complex) {
 
 int runInfo(const std::string& input, bool json, bool perLevel) {
   std::vector<uint8_t> bytes;
-  std::string error;
-  if (!readBytes(input, bytes, error)) return fail(error);
+  if (auto s = kdmesh::io::readBytes(input, bytes); !s.ok()) return fail(s, input);
   kdmesh::DecoderOptions options;
   options.measureCost = true;
   kdmesh::Decoder decoder(options);

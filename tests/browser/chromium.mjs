@@ -9,3 +9,16 @@ export function launchChromium() {
     args: ['--no-sandbox', '--disable-background-networking', '--use-angle=swiftshader', '--enable-unsafe-swiftshader'],
   });
 }
+
+// A page served at `${base}/${name}` with `html` as its body (the server
+// serves the models and the package beside it); resolves once the page sets
+// window.ready. `errors` collects uncaught page errors.
+export async function openTestPage(browser, base, name, html) {
+  const page = await browser.newPage();
+  const errors = [];
+  page.on('pageerror', (error) => errors.push(error.message));
+  await page.route(`${base}/${name}`, (route) => route.fulfill({ body: html, contentType: 'text/html' }));
+  await page.goto(`${base}/${name}`);
+  await page.waitForFunction(() => window.ready);
+  return { page, errors };
+}

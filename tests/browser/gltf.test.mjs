@@ -8,7 +8,7 @@ import { execFileSync } from 'node:child_process';
 import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { launchChromium } from './chromium.mjs';
+import { launchChromium, openTestPage } from './chromium.mjs';
 import { decode } from 'kdmesh';
 import { startServer } from '../../web/server.mjs';
 import { modelChecksum } from '../../web/model-checksum.js';
@@ -69,15 +69,7 @@ after(async () => {
   rmSync(models, { recursive: true, force: true });
 });
 
-async function openPage() {
-  const page = await browser.newPage();
-  const errors = [];
-  page.on('pageerror', (error) => errors.push(error.message));
-  await page.route(`${base}/gltf-test.html`, (route) => route.fulfill({ body: testPage, contentType: 'text/html' }));
-  await page.goto(`${base}/gltf-test.html`);
-  await page.waitForFunction(() => window.ready);
-  return { page, errors };
-}
+const openPage = () => openTestPage(browser, base, 'gltf-test.html', testPage);
 
 test('a paced .kdm.glb: the scene comes before its geometry is complete, which then refines to the stream', async () => {
   const { page, errors } = await openPage();

@@ -9,7 +9,7 @@ import { execFileSync } from 'node:child_process';
 import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { launchChromium } from './chromium.mjs';
+import { launchChromium, openTestPage } from './chromium.mjs';
 import { decode } from 'kdmesh';
 import { startServer } from '../../web/server.mjs';
 import { modelChecksum } from '../../web/model-checksum.js';
@@ -48,15 +48,7 @@ after(async () => {
   rmSync(models, { recursive: true, force: true });
 });
 
-async function openPage() {
-  const page = await browser.newPage();
-  const errors = [];
-  page.on('pageerror', (error) => errors.push(error.message));
-  await page.route(`${base}/loader-test.html`, (route) => route.fulfill({ body: testPage, contentType: 'text/html' }));
-  await page.goto(`${base}/loader-test.html`);
-  await page.waitForFunction(() => window.ready);
-  return { page, errors };
-}
+const openPage = () => openTestPage(browser, base, 'loader-test.html', testPage);
 
 test('LoadingManager: itemStart, progress, itemError and itemEnd, resolveURL, path and request headers', async () => {
   const { page, errors } = await openPage();

@@ -130,6 +130,10 @@ struct WriteOptions {
 // writeMemory(TetGen) gives the .node alone and so refuses tetrahedra.
 Status writeMemory(Format format, const Complex& complex,
                    std::vector<uint8_t>& out, const WriteOptions& options = {});
+// The whole file at `path` (a .kdm stream, a glTF scene), or an error that
+// names it.
+Status readBytes(const std::string& path, std::vector<uint8_t>& bytes);
+
 Status writeFile(const std::string& path, const Complex& complex,
                  const WriteOptions& options = {});
 

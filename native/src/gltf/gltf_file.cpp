@@ -55,20 +55,6 @@ bool keepImageReference(const std::string*, const std::string*, const tinygltf::
   return false;
 }
 
-bool readWholeFile(const std::string& path, std::vector<uint8_t>& bytes, std::string& error) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) {
-    error = "cannot open " + path;
-    return false;
-  }
-  bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-  if (in.bad()) {
-    error = "cannot read " + path;
-    return false;
-  }
-  return true;
-}
-
 // JSON arrays and objects nest at most this deep in a scene (glTF needs
 // about 10): the JSON parsers recurse once per level, and a file of deeply
 // nested brackets would exhaust the stack.
@@ -176,15 +162,13 @@ Status readRelativeFile(const std::string& folder, const std::string& uri, std::
   }
   if (uri.empty() || scheme || uri[0] == '/' || uri[0] == '\\' || parent)
     return invalid("the stream URI \"" + uri + "\" is not a relative path inside the scene's folder");
-  std::string error;
-  if (!readWholeFile(folder + uri, bytes, error)) return Status::error(ErrorCode::InvalidInput, error);
-  return Status::success();
+  return io::readBytes(folder + uri, bytes);
 }
 
 Status loadScene(const std::string& path, tinygltf::Model& model, io::Notes& notes) {
   std::vector<uint8_t> bytes;
+  if (Status status = io::readBytes(path, bytes); !status.ok()) return status;
   std::string error;
-  if (!readWholeFile(path, bytes, error)) return invalid(error);
   // tinygltf takes 32-bit sizes, as the .glb header does.
   if (bytes.size() >= (uint64_t{1} << 32)) return invalid(path + ": larger than 4 GiB, which glTF cannot hold");
   tinygltf::TinyGLTF loader;

@@ -164,6 +164,21 @@ Status readInput(Format format, Input& input, Complex& out, Notes& notes,
   return status;
 }
 
+}  // namespace
+
+Status readBytes(const std::string& path, std::vector<uint8_t>& bytes) {
+  bytes.clear();
+  FilePtr file(std::fopen(path.c_str(), "rb"));
+  if (!file) return fileError("cannot open", path);
+  uint8_t block[1 << 16];
+  for (size_t got; (got = std::fread(block, 1, sizeof block, file.get())) > 0;)
+    bytes.insert(bytes.end(), block, block + got);
+  if (std::ferror(file.get())) return fileError("cannot read", path);
+  return Status::success();
+}
+
+namespace {
+
 Status writeWholeFile(const std::string& path,
                       const std::vector<uint8_t>& bytes) {
   FilePtr file(std::fopen(path.c_str(), "wb"));
