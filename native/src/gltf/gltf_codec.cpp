@@ -186,7 +186,7 @@ Status encodeFile(const std::string& input, const std::string& output, const Enc
           detail::setBounds(accessor, reinterpret_cast<const uint8_t*>(complex.positions.data()), vertexCount);
         } else if (!accessor.minValues.empty()) {
           const auto& attribute = *std::find_if(complex.attributes.begin(), complex.attributes.end(),
-                                                [&](const VertexAttribute& a) { return a.name == semantic; });
+                                                [&name = semantic](const VertexAttribute& a) { return a.name == name; });
           detail::setBounds(accessor, attribute.values.data(), vertexCount);
         }
       }

@@ -255,7 +255,7 @@ Status writeDecodedPrimitive(tinygltf::Model& model, tinygltf::Primitive& primit
       continue;
     }
     const VertexAttribute* attribute =
-        std::find_if(attributes.begin(), attributes.end(), [&](const auto& a) { return a.first == semantic; })->second;
+        std::find_if(attributes.begin(), attributes.end(), [&name = semantic](const auto& a) { return a.first == name; })->second;
     pointAt(accessor, writer.addVertexAttribute(attribute->values.data(), vertexCount, attribute->valueBytes()),
             vertexCount);
     if (!accessor.minValues.empty()) setBounds(accessor, attribute->values.data(), vertexCount);
