@@ -105,7 +105,7 @@ class Mixer {
   // of `inputs`, then updates the inputs and the weights: codeWithMixers()
   // with this mixer alone.
   template <class Coder>
-  bool code(Coder& coder, int set, const std::array<BitModel*, kInputs>& inputs, bool bit) {
+  [[gnu::always_inline]] bool code(Coder& coder, int set, const std::array<BitModel*, kInputs>& inputs, bool bit) {
     return codeWithMixers<Coder, kInputs, 1>(coder, {this}, {set}, inputs, bit);
   }
 

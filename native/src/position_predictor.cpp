@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 namespace kdmesh {
 namespace {
@@ -111,16 +112,23 @@ double middleOf(const double* sorted, uint32_t count) {
 }
 
 // Applies a network of comparisons to eight values, each a min and a max:
-// no branch on the data, which falls either way at random. Unrolled, the
-// values stay in registers.
+// no branch on the data, which falls either way at random. Expanded at
+// compile time and inlined, so that the values stay in registers whatever
+// the compiler's unrolling rules (clang, which builds the WebAssembly
+// decoder, ignores GCC's unroll pragma and called a loop over memory).
+template <size_t kComparisons, size_t... kIndex>
+[[gnu::always_inline]] inline void applyNetwork(double (&v)[8], const uint8_t (&pairs)[kComparisons][2],
+                                                std::index_sequence<kIndex...>) {
+  auto compareAndSwap = [&v](size_t i, size_t j) {
+    const double low = std::min(v[i], v[j]), high = std::max(v[i], v[j]);
+    v[i] = low;
+    v[j] = high;
+  };
+  (compareAndSwap(pairs[kIndex][0], pairs[kIndex][1]), ...);
+}
 template <size_t kComparisons>
-void sortNetwork(double (&v)[8], const uint8_t (&pairs)[kComparisons][2]) {
-#pragma GCC unroll 19
-  for (const auto& pair : pairs) {
-    const double low = std::min(v[pair[0]], v[pair[1]]), high = std::max(v[pair[0]], v[pair[1]]);
-    v[pair[0]] = low;
-    v[pair[1]] = high;
-  }
+[[gnu::always_inline]] inline void sortNetwork(double (&v)[8], const uint8_t (&pairs)[kComparisons][2]) {
+  applyNetwork(v, pairs, std::make_index_sequence<kComparisons>());
 }
 // Any eight values (Knuth's 19 comparisons).
 constexpr uint8_t kSortEight[19][2] = {{0, 2}, {1, 3}, {4, 6}, {5, 7}, {0, 4}, {1, 5}, {2, 6},

@@ -189,13 +189,15 @@ class RangeDecoder {
     for (int i = 0; i < 4; ++i) code_ = (code_ << 8) | nextByte();
   }
 
-  bool bit(BitModel& model, bool /*unused*/ = false) {
+  // Inlined always, as every decision of the decoder passes here: clang
+  // (the WebAssembly build) left these calls out of line.
+  [[gnu::always_inline]] bool bit(BitModel& model, bool /*unused*/ = false) {
     const bool value = bitWithProbability(model.probabilityOfZero());
     model.update(value);
     return value;
   }
 
-  bool bitWithProbability(uint32_t p0, bool /*unused*/ = false) {
+  [[gnu::always_inline]] bool bitWithProbability(uint32_t p0, bool /*unused*/ = false) {
     const uint32_t bound = (range_ >> kProbabilityBits) * p0;
     bool value;
     if (code_ < bound) {
