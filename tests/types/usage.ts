@@ -1,7 +1,8 @@
 // Uses every export of kdmesh, kdmesh/three and kdmesh/gltf as a TypeScript program
 // would; tests/types/types.test.mjs compiles it with tsc --strict.
 import {
-  compileWasm, createDecoder, decode, Decoder, Header, KdmeshError, memoryInUse, Model, Progress, setWasmSource, VertexAttribute,
+  AttributeCoding, compileWasm, createDecoder, decode, Decoder, Header, KdmeshError, memoryInUse, Model, Progress, setWasmSource,
+  VertexAttribute,
 } from 'kdmesh';
 import { GpuFence, KDMeshLoader, LoadStats, StreamedModel } from 'kdmesh/three';
 import { BufferGeometry, Group, LoadingManager, Mesh, MeshNormalMaterial, PerspectiveCamera, Scene, WebGLRenderer } from 'three';
@@ -17,7 +18,9 @@ export async function decoding(bytes: Uint8Array): Promise<number> {
   const coarse = decoder.snapshot({ copy: false });
   const parents: Uint32Array = decoder.parents();
   const colour: VertexAttribute | undefined = coarse.attributes.color;
-  const attributeValues = (colour?.array.length ?? 0) + (colour?.itemSize ?? 0) + (header?.attributeCount ?? 0);
+  const coding: AttributeCoding | undefined = coarse.attributes.normal?.coding;
+  const quantized = coding === 'uniform' || coding === 'octahedral' ? coarse.attributes.normal.codingBits : 0;
+  const attributeValues = (colour?.array.length ?? 0) + (colour?.itemSize ?? 0) + (header?.attributeCount ?? 0) + quantized;
   const regions: Int32Array | undefined = header?.labelled ? coarse.labels?.triangles : undefined;
   decoder.finish();
   decoder.dispose();
