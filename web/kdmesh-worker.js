@@ -16,8 +16,10 @@
 //
 // A snapshot's arrays are sized for the final model, so that the page can
 // adopt them as GPU buffer storage: positions, normals and each vertex
-// attribute (model.attributes, name -> {array, itemSize}) in their own
-// storage, the lists of simplices packed (see pack()).
+// attribute (model.attributes, name -> {array, itemSize, ...}) in their own
+// storage, the lists of simplices packed (see pack()), and the surface's
+// index (model.surface) with, for labelled streams, its triangles ordered
+// by label into model.groups (see orderByLabel()).
 import { createDecoder, setWasmSource } from './kdmesh.js';
 
 let wasmSet = false;
@@ -25,6 +27,7 @@ let job = null;  // the stream being decoded (see start())
 
 // Faces of the tetrahedra that belong to exactly one: the visible surface of
 // a tetrahedral mesh, oriented outwards when the tetrahedra are positive.
+// `owners[i]` is the tetrahedron of face i (whose label the face shows).
 function boundaryOfTetrahedra(tetrahedra) {
   const faces = new Map();
   const corners = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]];
@@ -33,13 +36,48 @@ function boundaryOfTetrahedra(tetrahedra) {
       const face = [tetrahedra[t + a], tetrahedra[t + b], tetrahedra[t + c]];
       const key = face.slice().sort((x, y) => x - y).join(',');
       if (faces.has(key)) faces.delete(key);
-      else faces.set(key, face);
+      else faces.set(key, { face, owner: t / 4 });
     }
   }
-  const out = new Uint32Array(faces.size * 3);
+  const triangles = new Uint32Array(faces.size * 3);
+  const owners = new Uint32Array(faces.size);
   let i = 0;
-  for (const face of faces.values()) out.set(face, 3 * i++);
-  return out;
+  for (const { face, owner } of faces.values()) {
+    owners[i] = owner;
+    triangles.set(face, 3 * i++);
+  }
+  return { triangles, owners };
+}
+
+// The drawn triangles of a labelled stream (`triangles`, 3 indices each,
+// with `labels`, one per triangle) ordered by label for three.js's
+// geometry groups: in new storage of at least `capacity` elements (see
+// pack()), the triangles of each label in one range, the labels in
+// ascending order, each label's triangles in their order here (a stable
+// counting sort: one pass to count, one to place). Returns the ordered
+// triangles and one group per distinct label, { start, count } in indices,
+// materialIndex the label's rank, and the label.
+function orderByLabel(triangles, labels, capacity) {
+  const counts = new Map();
+  for (let t = 0; t < labels.length; ++t) counts.set(labels[t], (counts.get(labels[t]) ?? 0) + 1);
+  const distinct = Int32Array.from(counts.keys()).sort();
+  const next = new Map();  // label -> where its next triangle goes, in triangles
+  let start = 0;
+  const groups = Array.from(distinct, (label, materialIndex) => {
+    const count = 3 * counts.get(label);
+    next.set(label, start / 3);
+    start += count;
+    return { start: start - count, count, materialIndex, label };
+  });
+  const storage = new Uint32Array(Math.max(triangles.length, capacity));
+  for (let t = 0; t < labels.length; ++t) {
+    const to = next.get(labels[t]);
+    next.set(labels[t], to + 1);
+    storage[3 * to] = triangles[3 * t];
+    storage[3 * to + 1] = triangles[3 * t + 1];
+    storage[3 * to + 2] = triangles[3 * t + 2];
+  }
+  return { surface: storage.subarray(0, triangles.length), groups };
 }
 
 // Area-weighted vertex normals of the triangles, for streams without normals
@@ -138,7 +176,8 @@ function sendSnapshot() {
   if (!decoder || !job.wanted || !job.changed || !snapshotDue()) return;
   const began = performance.now();
   const live = decoder.snapshot({ copy: false });  // views, valid until the next call on the decoder
-  const boundary = live.tetrahedra.length ? boundaryOfTetrahedra(live.tetrahedra) : new Uint32Array(0);
+  const { triangles: boundary, owners } = live.tetrahedra.length ? boundaryOfTetrahedra(live.tetrahedra)
+    : { triangles: new Uint32Array(0), owners: new Uint32Array(0) };
   const tetrahedronEdges = live.tetrahedra.length && wireframe ? edgesOfTetrahedra(live.tetrahedra) : new Uint32Array(0);
   // Capacities: the final maximal simplices and isolated vertices, and for
   // tetrahedra up to four boundary triangles and six edges each.
@@ -147,12 +186,24 @@ function sendSnapshot() {
   const [points] = pack(Uint32Array, [live.points], pointCount);
   const [edges, tetrahedronEdgesInPlace] = pack(Uint32Array, [live.edges, tetrahedronEdges],
     2 * (edgeCount + (wireframe ? 6 * tetrahedronCount : 0)));
-  const [triangles, boundaryInPlace] = pack(Uint32Array, [live.triangles, boundary], 3 * (triangleCount + 4 * tetrahedronCount));
+  // The surface's index: the triangles, then the boundary of the
+  // tetrahedra, in storage sized for the final model; for labelled streams
+  // that is the surface ordered by label (the boundary's triangles with
+  // their tetrahedra's labels), and `triangles` a copy in the decoder's order.
+  const surfaceCapacity = 3 * (triangleCount + 4 * tetrahedronCount);
+  const [triangles, boundaryInPlace] = pack(Uint32Array, [live.triangles, boundary], live.labels ? 0 : surfaceCapacity);
   const drawnTriangles = new Uint32Array(triangles.buffer, 0, triangles.length + boundary.length);  // both lists
+  let surface = drawnTriangles, groups = [];
+  if (live.labels) {
+    const drawnLabels = new Int32Array(drawnTriangles.length / 3);
+    drawnLabels.set(live.labels.triangles);
+    for (let i = 0; i < owners.length; ++i) drawnLabels[live.labels.triangles.length + i] = live.labels.tetrahedra[owners[i]];
+    ({ surface, groups } = orderByLabel(drawnTriangles, drawnLabels, surfaceCapacity));
+  }
   // Each vertex attribute in storage of its own, sized like the positions'.
   const attributes = {};
-  for (const [name, { array, itemSize }] of Object.entries(live.attributes))
-    attributes[name] = { array: pack(array.constructor, [array], vertexCount * itemSize)[0], itemSize };
+  for (const [name, attribute] of Object.entries(live.attributes))
+    attributes[name] = { ...attribute, array: pack(attribute.array.constructor, [attribute.array], vertexCount * attribute.itemSize)[0] };
   // Simplex labels (labelled streams): copies, as the views into the
   // decoder's memory must not be posted (a view posts its whole buffer).
   const labels = live.labels && {
@@ -161,7 +212,7 @@ function sendSnapshot() {
   };
   const model = {
     ...live, positions, points, edges, triangles, tetrahedra: live.tetrahedra.slice(), attributes, labels,
-    boundary: boundaryInPlace, tetrahedronEdges: tetrahedronEdgesInPlace,
+    boundary: boundaryInPlace, tetrahedronEdges: tetrahedronEdgesInPlace, surface, groups,
     bounds: bounds(positions),
     normals: streamNormals(attributes) ??
       (drawnTriangles.length && job.normals ? vertexNormals(positions, drawnTriangles) : new Float32Array(0)),
@@ -172,7 +223,7 @@ function sendSnapshot() {
   job.changed = false;
   job.decodeMs = 0;
   job.handOverMs = performance.now() - began;
-  const buffers = [positions, points, edges, triangles, model.tetrahedra, model.normals, model.parents,
+  const buffers = [positions, points, edges, triangles, surface, model.tetrahedra, model.normals, model.parents,
     ...Object.values(attributes).map((a) => a.array), ...(labels ? Object.values(labels) : [])]
     .map((a) => a.buffer).filter((b, i, all) => b.byteLength && all.indexOf(b) === i);
   postMessage({ type: 'snapshot', model }, buffers);

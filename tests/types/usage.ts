@@ -4,8 +4,10 @@ import {
   AttributeCoding, compileWasm, createDecoder, decode, Decoder, Header, KdmeshError, memoryInUse, Model, Progress, setWasmSource,
   VertexAttribute,
 } from 'kdmesh';
-import { GpuFence, KDMeshLoader, LoadStats, StreamedModel } from 'kdmesh/three';
-import { BufferGeometry, Group, LoadingManager, Mesh, MeshNormalMaterial, PerspectiveCamera, Scene, WebGLRenderer } from 'three';
+import { GpuFence, KDMeshLoader, LabelGroup, LoadStats, StreamedModel } from 'kdmesh/three';
+import {
+  BufferGeometry, Group, LoadingManager, Mesh, MeshBasicMaterial, MeshNormalMaterial, PerspectiveCamera, Scene, WebGLRenderer,
+} from 'three';
 
 export async function decoding(bytes: Uint8Array): Promise<number> {
   setWasmSource(new URL('https://example.com/kdmesh-wasm.wasm'));
@@ -71,9 +73,19 @@ export async function loading(renderer: WebGLRenderer): Promise<BufferGeometry> 
   scene.add(new Mesh(geometry, new MeshNormalMaterial()));
   const primitive: 'triangles' | 'lines' | 'points' | undefined = geometry.userData.primitive;
   await geometry.userData.loaded;
+  // Simplex labels as groups: one material per label rank.
+  const byLabel = loader.loadProgressive('e.kdm', {
+    materials: [new MeshBasicMaterial({ color: 0xff0000 }), new MeshBasicMaterial({ color: 0x00ff00 })],
+    onRefine: (object: Group, stats: LoadStats) => {
+      const groups: LabelGroup[] = stats.model?.groups ?? [];
+      return groups.every((g) => g.materialIndex >= 0 && g.start + g.count <= (stats.model?.surface.length ?? 0) && g.label !== 0.5);
+    },
+  });
+  const labels: number[] | undefined = geometry.userData.labels;
+  scene.add(byLabel);
   const fence = new GpuFence(renderer.getContext() as WebGL2RenderingContext);
   fence.set();
-  const busy: number = loader.busyWorkers + (fence.passed() ? 1 : 0) + (primitive ? 1 : 0) + whole.children.length;
+  const busy: number = loader.busyWorkers + (fence.passed() ? 1 : 0) + (primitive ? 1 : 0) + whole.children.length + (labels?.length ?? 0);
   loader.materials.surface.color.set(busy);
   return loader.abort().dispose() === loader ? geometry : new BufferGeometry();
 }
