@@ -17,6 +17,9 @@ const viewer = (window.kdmeshViewer = {
   pointCount: 0, bytesReceived: 0, bytesExpected: 0, level: 0, error: null, firstRenderMs: null,
   // Names of the model's vertex attributes ('color' draws as vertex colours).
   attributes: [],
+  // A stream with simplex labels: the labels of the level drawn, ascending
+  // (one per surface group), and whether the surface is coloured by them.
+  labelled: false, labels: [], colouredByLabel: false,
   // A glTF scene: its compressed primitives (streams) and those complete.
   streams: 0, streamsComplete: 0,
   // The complete model's totals, from the stream's header.
@@ -184,6 +187,44 @@ function fitFog() {
   scene.fog.far = distance + 3 * modelRadius;
 }
 
+// Colouring by label: the surface Mesh draws each label group with a
+// material of a fixed palette. A label keeps the colour it got when it first
+// appeared (the next of the palette, cycling; not its rank, which changes
+// when a finer level brings a new label), so that a region keeps its colour
+// from level to level. One material per palette colour, made on first use.
+const labelPalette = [0x4e79a7, 0xf28e2b, 0xe15759, 0x76b7b2, 0x59a14f, 0xedc948, 0xb07aa1, 0xff9da7, 0x9c755f, 0xbab0ac];
+const labelColours = new Map();  // label -> palette colour, for the current model
+const labelMaterials = new Map();  // palette colour -> material
+function labelMaterial(label) {
+  if (!labelColours.has(label)) labelColours.set(label, labelPalette[labelColours.size % labelPalette.length]);
+  const colour = labelColours.get(label);
+  if (!labelMaterials.has(colour)) {
+    const material = loader.materials.surface.clone();
+    material.color.set(colour);
+    labelMaterials.set(colour, material);
+  }
+  return labelMaterials.get(colour);
+}
+
+// The surface of the current model coloured by label when the toggle is on
+// and the level has label groups, else with the material the loader gave it
+// (kept aside while the palette is on).
+function colourByLabel() {
+  const surface = current?.children?.[0];
+  if (!surface?.isMesh) return;
+  const labels = surface.geometry.userData.labels;
+  const on = $('labels').checked && Boolean(labels?.length);
+  if (on) {
+    if (!Array.isArray(surface.material)) surface.userData.ownMaterial = surface.material;
+    surface.material = labels.map(labelMaterial);
+  } else if (surface.userData.ownMaterial) {
+    surface.material = surface.userData.ownMaterial;
+    delete surface.userData.ownMaterial;
+  }
+  viewer.colouredByLabel = on;
+  requestRender();
+}
+
 function frame(group) {
   const box = new THREE.Box3().setFromObject(group);
   if (box.isEmpty()) return;
@@ -236,6 +277,7 @@ function describe(stats) {
     (viewer.tetrahedronCount ? ` · ${count(viewer.tetrahedronCount)} tetrahedra` : '') +
     (viewer.edgeCount ? ` · ${count(viewer.edgeCount)} edges` : '') +
     (viewer.attributes.length ? ` · ${viewer.attributes.join(', ')}` : '') +
+    (viewer.labelled ? ` · ${count(viewer.labels.length)} labels` : '') +
     ` · ${bpv} bits/vertex${m?.complete ? '' : ' so far'}`;
 }
 
@@ -253,7 +295,10 @@ function start(load) {
   Object.assign(viewer, {
     state: 'loading', refinements: 0, error: null, firstRenderMs: null, completeMs: null, finalRenderMs: null, bytesReceived: 0,
     bytesExpected: 0, levelCount: 0, vertexTotal: 0, levelsSeen: [], longTasks: [], attributes: [], streams: 0, streamsComplete: 0,
+    labelled: false, labels: [], colouredByLabel: false,
   });
+  $('labels-option').hidden = true;
+  labelColours.clear();
   pendingStatus = pendingProgress = null;
   $('progress').value = $('decoded').value = 0;
   showStatus('loading…');
@@ -269,7 +314,8 @@ function start(load) {
     onAnimate: requestRender,
     onHeader(header) {
       if (!isCurrent()) return;
-      Object.assign(viewer, { levelCount: header.depth, vertexTotal: header.vertexCount });
+      Object.assign(viewer, { levelCount: header.depth, vertexTotal: header.vertexCount, labelled: header.labelled });
+      $('labels-option').hidden = !header.labelled;  // offered only for models with labels
     },
     onProgress(stats) {
       if (!isCurrent()) return;
@@ -283,8 +329,9 @@ function start(load) {
       Object.assign(viewer, {
         refinements: stats.refinements, vertexCount: m.vertexCount, triangleCount: m.triangles.length / 3,
         tetrahedronCount: m.tetrahedra.length / 4, edgeCount: m.edges.length / 2, pointCount: m.points.length,
-        level: m.progress.level, attributes: Object.keys(m.attributes),
+        level: m.progress.level, attributes: Object.keys(m.attributes), labels: m.groups.map((group) => group.label),
       });
+      colourByLabel();
       if (!viewer.levelsSeen.includes(m.progress.level)) viewer.levelsSeen.push(m.progress.level);
       if (!framed) { frame(model); framed = true; }
       if (m.complete) {
@@ -462,6 +509,7 @@ $('throttle').addEventListener('change', () => reloadCurrent?.());
 $('stop').addEventListener('click', () => controller?.abort());
 $('geomorph').addEventListener('change', () => reloadCurrent?.());
 $('wireframe').addEventListener('change', () => reloadCurrent?.());
+$('labels').addEventListener('change', colourByLabel);
 
 $('file').addEventListener('change', () => $('file').files[0] && openFile($('file').files[0]));
 const view = $('view');

@@ -10,7 +10,7 @@ import { launchChromium } from './chromium.mjs';
 import { decode } from 'kdmesh';
 import { startServer } from '../../web/server.mjs';
 import { modelChecksum } from '../../web/model-checksum.js';
-import { root, cli, colouredTorus, writePly } from '../js/fixtures.mjs';
+import { root, cli, colouredTorus, labelledTorus, writeLabelledPly, writePly } from '../js/fixtures.mjs';
 import { writeTestScene } from '../js/gltf-fixtures.mjs';
 
 const models = mkdtempSync(join(tmpdir(), 'kdmesh-browser-'));
@@ -31,6 +31,9 @@ before(async () => {
   // A torus with vertex colours, red on one side and blue on the other.
   writePly(join(models, 'coloured.ply'), colouredTorus());
   execFileSync(cli, ['encode', join(models, 'coloured.ply'), '-o', join(models, 'coloured.kdm'), '--bits', '12', '-q']);
+  // A torus whose triangles carry four labels, one per quarter.
+  writeLabelledPly(join(models, 'labelled.ply'), labelledTorus());
+  execFileSync(cli, ['encode', join(models, 'labelled.ply'), '-o', join(models, 'labelled.kdm'), '--bits', '12', '-q']);
   // A glTF scene whose torus, line loop and point cloud are kdmesh streams.
   writeTestScene(join(models, 'input-scene.glb'));
   execFileSync(cli, ['encode', join(models, 'input-scene.glb'), '-o', join(models, 'scene.kdm.glb'), '-q']);
@@ -249,6 +252,55 @@ test('a glTF scene from the gallery and from the file picker: its streams comple
   await page.setInputFiles('#file', { name: 'picked.kdm.glb', mimeType: 'model/gltf-binary', buffer: readFileSync(join(models, 'scene.kdm.glb')) });
   await page.waitForFunction(() => window.kdmeshViewer.source === 'picked.kdm.glb' && window.kdmeshViewer.state === 'complete', null, { timeout: 60000 });
   assert.equal((await viewerState(page)).streamsComplete, 3);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('a labelled model offers colouring by label, which draws the label groups in palette colours', async () => {
+  // Pixels of the canvas's last frame whose red exceeds their blue by more
+  // than 40: the default surface is grey-blue, the palette's second and
+  // third colours are orange and red.
+  const warmPixels = (page) => page.evaluate(async () => {
+    await new Promise((resolve) => requestAnimationFrame(() => requestAnimationFrame(resolve)));
+    const view = document.querySelector('#view canvas');
+    const canvas = document.createElement('canvas');
+    canvas.width = view.width;
+    canvas.height = view.height;
+    const context = canvas.getContext('2d');
+    context.drawImage(view, 0, 0);
+    const data = context.getImageData(0, 0, canvas.width, canvas.height).data;
+    let count = 0;
+    for (let i = 0; i < data.length; i += 4) if (data[i] > data[i + 2] + 40) ++count;
+    return count;
+  });
+  const { page, errors } = await openViewer('model=coloured.kdm');
+  await page.waitForFunction(() => window.kdmeshViewer.state === 'complete', null, { timeout: 60000 });
+  assert.equal(await page.isVisible('#labels'), false, 'no label option for a model without labels');
+  await page.selectOption('#model', 'labelled.kdm');
+  await page.waitForFunction(() => window.kdmeshViewer.state === 'complete' && window.kdmeshViewer.source.includes('labelled'), null,
+    { timeout: 60000 });
+  assert.equal(await page.isVisible('#labels'), true);
+  let state = await viewerState(page);
+  assert.deepEqual({ labelled: state.labelled, labels: state.labels, coloured: state.colouredByLabel },
+    { labelled: true, labels: [-1, 10, 20, 30], coloured: false });
+  assert.match(await page.textContent('#status'), /4 labels/);
+  const plain = await warmPixels(page);
+  await page.click('#labels');
+  await page.waitForFunction(() => window.kdmeshViewer.colouredByLabel);
+  const coloured = await warmPixels(page);
+  await page.screenshot({ path: join(screenshots, 'labelled-torus.png') });
+  await page.click('#labels');
+  await page.waitForFunction(() => !window.kdmeshViewer.colouredByLabel);
+  const again = await warmPixels(page);
+  assert.ok(plain < 50 && again < 50, `warm pixels without label colours: ${plain}, ${again}`);
+  assert.ok(coloured > 2000, `warm pixels with label colours: ${coloured}`);
+  // Loading again with the toggle on colours every level as it arrives.
+  await page.click('#labels');
+  await page.selectOption('#throttle', '256');
+  await page.waitForFunction(() => window.kdmeshViewer.state === 'complete', null, { timeout: 60000 });
+  state = await viewerState(page);
+  assert.equal(state.colouredByLabel, true);
+  assert.ok(await warmPixels(page) > 2000);
   assert.deepEqual(errors, []);
   await page.close();
 });
