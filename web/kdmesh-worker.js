@@ -54,28 +54,40 @@ function boundaryOfTetrahedra(tetrahedra) {
 // geometry groups: in new storage of at least `capacity` elements (see
 // pack()), the triangles of each label in one range, the labels in
 // ascending order, each label's triangles in their order here (a stable
-// counting sort: one pass to count, one to place). Returns the ordered
+// counting sort: one pass to count, one to place). Labels come in runs, so
+// a label like the last skips the look-up of its slot. Returns the ordered
 // triangles and one group per distinct label, { start, count } in indices,
 // materialIndex the label's rank, and the label.
 function orderByLabel(triangles, labels, capacity) {
-  const counts = new Map();
-  for (let t = 0; t < labels.length; ++t) counts.set(labels[t], (counts.get(labels[t]) ?? 0) + 1);
-  const distinct = Int32Array.from(counts.keys()).sort();
-  const next = new Map();  // label -> where its next triangle goes, in triangles
+  const slotOf = new Map();  // label -> its slot in `counts`, in order of appearance
+  const slots = new Uint32Array(labels.length);
+  const counts = [];
+  let last = 0, slot = -1;
+  for (let t = 0; t < labels.length; ++t) {
+    const label = labels[t];
+    if (slot < 0 || label !== last) {
+      slot = slotOf.get(label) ?? -1;
+      if (slot < 0) slotOf.set(label, (slot = counts.push(0) - 1));
+      last = label;
+    }
+    slots[t] = slot;
+    ++counts[slot];
+  }
+  // Where each slot's next triangle goes, in triangles: after those of
+  // every smaller label.
+  const next = new Uint32Array(counts.length);
   let start = 0;
-  const groups = Array.from(distinct, (label, materialIndex) => {
-    const count = 3 * counts.get(label);
-    next.set(label, start / 3);
-    start += count;
-    return { start: start - count, count, materialIndex, label };
+  const groups = [...slotOf].sort((a, b) => a[0] - b[0]).map(([label, s], materialIndex) => {
+    next[s] = start;
+    start += counts[s];
+    return { start: 3 * (start - counts[s]), count: 3 * counts[s], materialIndex, label };
   });
   const storage = new Uint32Array(Math.max(triangles.length, capacity));
   for (let t = 0; t < labels.length; ++t) {
-    const to = next.get(labels[t]);
-    next.set(labels[t], to + 1);
-    storage[3 * to] = triangles[3 * t];
-    storage[3 * to + 1] = triangles[3 * t + 1];
-    storage[3 * to + 2] = triangles[3 * t + 2];
+    const to = 3 * next[slots[t]]++;
+    storage[to] = triangles[3 * t];
+    storage[to + 1] = triangles[3 * t + 1];
+    storage[to + 2] = triangles[3 * t + 2];
   }
   return { surface: storage.subarray(0, triangles.length), groups };
 }
