@@ -262,6 +262,11 @@ function paintStatus() {
   pendingStatus = pendingProgress = null;
 }
 
+// An attribute's name, with its coding when the stream quantized it.
+function describeAttribute(name, { coding, codingBits }) {
+  return coding === 'exact' ? name : `${name} (${coding} ${codingBits} bits)`;
+}
+
 function describe(stats) {
   const m = stats.model;
   const count = (n) => n.toLocaleString('en-US');
@@ -276,7 +281,7 @@ function describe(stats) {
     (viewer.triangleCount ? ` · ${count(viewer.triangleCount)} triangles` : '') +
     (viewer.tetrahedronCount ? ` · ${count(viewer.tetrahedronCount)} tetrahedra` : '') +
     (viewer.edgeCount ? ` · ${count(viewer.edgeCount)} edges` : '') +
-    (viewer.attributes.length ? ` · ${viewer.attributes.join(', ')}` : '') +
+    (viewer.attributes.length ? ` · ${viewer.attributes.map((name) => describeAttribute(name, m.attributes[name])).join(', ')}` : '') +
     (viewer.labelled ? ` · ${count(viewer.labels.length)} labels` : '') +
     ` · ${bpv} bits/vertex${m?.complete ? '' : ' so far'}`;
 }

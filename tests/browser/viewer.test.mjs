@@ -31,6 +31,8 @@ before(async () => {
   // A torus with vertex colours, red on one side and blue on the other.
   writePly(join(models, 'coloured.ply'), colouredTorus());
   execFileSync(cli, ['encode', join(models, 'coloured.ply'), '-o', join(models, 'coloured.kdm'), '--bits', '12', '-q']);
+  execFileSync(cli, ['encode', join(models, 'coloured.ply'), '-o', join(models, 'quantized.kdm'), '--bits', '12', '--attr-bits', '12',
+    '--normal-bits', '10', '-q']);
   // A torus whose triangles carry four labels, one per quarter.
   writeLabelledPly(join(models, 'labelled.ply'), labelledTorus());
   execFileSync(cli, ['encode', join(models, 'labelled.ply'), '-o', join(models, 'labelled.kdm'), '--bits', '12', '-q']);
@@ -301,6 +303,15 @@ test('a labelled model offers colouring by label, which draws the label groups i
   state = await viewerState(page);
   assert.equal(state.colouredByLabel, true);
   assert.ok(await warmPixels(page) > 2000);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('the status line says how quantized attributes are coded', async () => {
+  const { page, errors } = await openViewer('model=quantized.kdm');
+  await page.waitForFunction(() => window.kdmeshViewer.state === 'complete', null, { timeout: 60000 });
+  await page.waitForFunction(() => !document.getElementById('status').textContent.includes('so far'), null, { timeout: 10000 });
+  assert.match(await page.textContent('#status'), / · color, normal \(octahedral 10 bits\), uv \(uniform 12 bits\), label · /);
   assert.deepEqual(errors, []);
   await page.close();
 });
