@@ -214,12 +214,21 @@ test('an opened mesh file: encoding state, the menu shows it, toggles reload it;
 test('the header stays on one line at 1000 px, and the point cloud is shaded, not a flat silhouette', async () => {
   const { page, errors } = await openViewer('model=points', { width: 1000, height: 700 });
   await page.waitForFunction(() => window.kdmeshViewer.state === 'complete', null, { timeout: 60000 });
-  const tops = await page.$$eval('header > *', (children) => children.map((child) => Math.round(child.getBoundingClientRect().top)));
-  assert.ok(Math.max(...tops) - Math.min(...tops) <= 6, `tops of the header's items: ${tops}`);
+  // Tops of the header's items shown (the label option is hidden for models without labels).
+  const tops = () => page.$$eval('header > *', (children) => children.filter((child) => child.getClientRects().length)
+    .map((child) => Math.round(child.getBoundingClientRect().top)));
+  const points = await tops();
+  assert.ok(Math.max(...points) - Math.min(...points) <= 6, `tops of the header's items: ${points}`);
   assert.equal(await page.$eval('#file', (input) => input.accept.split(',').includes('.xyz')), true);
   const share = await page.evaluate(() => window.kdmeshViewer.commonestColourShare());
   await page.screenshot({ path: join(screenshots, 'points.png') });
   assert.ok(share > 0 && share < 0.2, `share of the commonest colour: ${share}`);
+  // With the label option shown too.
+  await page.selectOption('#model', 'labelled.kdm');
+  await page.waitForFunction(() => window.kdmeshViewer.state === 'complete' && window.kdmeshViewer.labelled, null, { timeout: 60000 });
+  const labelled = await tops();
+  assert.equal(labelled.length, points.length + 1);
+  assert.ok(Math.max(...labelled) - Math.min(...labelled) <= 6, `tops of the header's items: ${labelled}`);
   assert.deepEqual(errors, []);
   await page.close();
 });
@@ -285,7 +294,9 @@ test('a labelled model offers colouring by label, which draws the label groups i
   let state = await viewerState(page);
   assert.deepEqual({ labelled: state.labelled, labels: state.labels, coloured: state.colouredByLabel },
     { labelled: true, labels: [-1, 10, 20, 30], coloured: false });
-  assert.match(await page.textContent('#status'), /4 labels/);
+  // The status line is written at the next animation frame after the state.
+  await page.waitForFunction(() => / · 4 labels · .* bits\/vertex$/.test(document.getElementById('status').textContent), null,
+    { timeout: 10000 });
   const plain = await warmPixels(page);
   await page.click('#labels');
   await page.waitForFunction(() => window.kdmeshViewer.colouredByLabel);
