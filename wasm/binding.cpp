@@ -212,6 +212,10 @@ EMSCRIPTEN_KEEPALIVE uint32_t kdm_label_count(KdmDecoder* d, int dimension) {
 EMSCRIPTEN_KEEPALIVE const int32_t* kdm_labels(KdmDecoder* d, int dimension) {
   return d->snapshot.labels.of(dimension).data();
 }
+// The stream's label table (Decoder::labels()): its distinct labels,
+// ascending; none until it has arrived or when the stream has no labels.
+EMSCRIPTEN_KEEPALIVE uint32_t kdm_table_label_count(KdmDecoder* d) { return uint32_t(d->decoder.labels().size()); }
+EMSCRIPTEN_KEEPALIVE const int32_t* kdm_table_labels(KdmDecoder* d) { return d->decoder.labels().data(); }
 EMSCRIPTEN_KEEPALIVE uint32_t kdm_parent_count(KdmDecoder* d) { return uint32_t(d->decoder.vertexParents().size()); }
 EMSCRIPTEN_KEEPALIVE const uint32_t* kdm_parents(KdmDecoder* d) { return d->decoder.vertexParents().data(); }
 

@@ -11,8 +11,9 @@
 //               normals? (false: compute none)}
 //               (a new stream), {type: 'bytes', bytes}, {type: 'end'},
 //               {type: 'next'} (the page is ready for a snapshot)
-// Messages out: {type: 'header', header}, {type: 'snapshot', model} (the
-//               last one has model.complete), {type: 'error', code, message}
+// Messages out: {type: 'header', header} (with header.labels, see sendHeader()),
+//               {type: 'snapshot', model} (the last one has model.complete),
+//               {type: 'error', code, message}
 //
 // A snapshot's arrays are sized for the final model, so that the page can
 // adopt them as GPU buffer storage: positions, normals and each vertex
@@ -52,39 +53,37 @@ function boundaryOfTetrahedra(tetrahedra) {
 // The drawn triangles of a labelled stream (`triangles`, 3 indices each,
 // with `labels`, one per triangle) ordered by label for three.js's
 // geometry groups: in new storage of at least `capacity` elements (see
-// pack()), the triangles of each label in one range, the labels in
-// ascending order, each label's triangles in their order here (a stable
-// counting sort: one pass to count, one to place). Labels come in runs, so
-// a label like the last skips the look-up of its slot. Returns the ordered
-// triangles and one group per distinct label, { start, count } in indices,
-// materialIndex the label's rank, and the label.
-function orderByLabel(triangles, labels, capacity) {
-  const slotOf = new Map();  // label -> its slot in `counts`, in order of appearance
-  const slots = new Uint32Array(labels.length);
-  const counts = [];
-  let last = 0, slot = -1;
+// pack()), the triangles of each label in one range, in the order of the
+// stream's label table `table` (ascending), each label's triangles in their
+// order here (a stable counting sort: one pass to count, one to place).
+// `indexOf` maps each label to its index in the table; labels come in runs,
+// so a label like the last skips the look-up. Returns the ordered triangles
+// and one group per label the triangles have, { start, count } in indices,
+// materialIndex the label's index in the table (the same at every level,
+// whichever labels a level lacks), and the label.
+function orderByLabel(triangles, labels, table, indexOf, capacity) {
+  const indices = new Uint32Array(labels.length);
+  const counts = new Uint32Array(table.length);
+  let last = 0, index = -1;
   for (let t = 0; t < labels.length; ++t) {
-    const label = labels[t];
-    if (slot < 0 || label !== last) {
-      slot = slotOf.get(label) ?? -1;
-      if (slot < 0) slotOf.set(label, (slot = counts.push(0) - 1));
-      last = label;
+    if (index < 0 || labels[t] !== last) {
+      last = labels[t];
+      index = indexOf.get(last);
     }
-    slots[t] = slot;
-    ++counts[slot];
+    indices[t] = index;
+    ++counts[index];
   }
-  // Where each slot's next triangle goes, in triangles: after those of
+  // Where each label's next triangle goes, in triangles: after those of
   // every smaller label.
-  const next = new Uint32Array(counts.length);
-  let start = 0;
-  const groups = [...slotOf].sort((a, b) => a[0] - b[0]).map(([label, s], materialIndex) => {
-    next[s] = start;
-    start += counts[s];
-    return { start: 3 * (start - counts[s]), count: 3 * counts[s], materialIndex, label };
-  });
+  const next = new Uint32Array(table.length);
+  const groups = [];
+  for (let i = 0, start = 0; i < table.length; start += counts[i++]) {
+    next[i] = start;
+    if (counts[i]) groups.push({ start: 3 * start, count: 3 * counts[i], materialIndex: i, label: table[i] });
+  }
   const storage = new Uint32Array(Math.max(triangles.length, capacity));
   for (let t = 0; t < labels.length; ++t) {
-    const to = 3 * next[slots[t]]++;
+    const to = 3 * next[indices[t]]++;
     storage[to] = triangles[3 * t];
     storage[to + 1] = triangles[3 * t + 1];
     storage[to + 2] = triangles[3 * t + 2];
@@ -210,7 +209,7 @@ function sendSnapshot() {
     const drawnLabels = new Int32Array(drawnTriangles.length / 3);
     drawnLabels.set(live.labels.triangles);
     for (let i = 0; i < owners.length; ++i) drawnLabels[live.labels.triangles.length + i] = live.labels.tetrahedra[owners[i]];
-    ({ surface, groups } = orderByLabel(drawnTriangles, drawnLabels, surfaceCapacity));
+    ({ surface, groups } = orderByLabel(drawnTriangles, drawnLabels, job.labels, job.labelIndex, surfaceCapacity));
   }
   // Each vertex attribute in storage of its own, sized like the positions'.
   const attributes = {};
@@ -250,7 +249,22 @@ function end() {
   job.done = true;
 }
 
+// The header goes to the page once the stream's label table (header.labels,
+// after the header and the attribute table) has arrived too, so that the
+// page knows every label's materialIndex before the first level; a stream
+// that fails before the table sends it without (labels null) first.
+function sendHeader() {
+  const { header } = job;
+  job.headerSent = true;
+  if (header.labels) {
+    job.labels = header.labels;
+    job.labelIndex = new Map(Array.from(header.labels, (label, index) => [label, index]));
+  }
+  postMessage({ type: 'header', header });
+}
+
 function fail(error) {
+  if (job.header && !job.headerSent) sendHeader();
   postMessage({ type: 'error', code: error.code ?? 'error', message: error.message ?? String(error) });
   end();
 }
@@ -270,9 +284,9 @@ function pump(current) {
       const began = performance.now();
       decoder.push(pending.shift());
       job.decodeMs += performance.now() - began;
-      if (!job.headerSent && decoder.header) {
-        job.headerSent = true;
-        postMessage({ type: 'header', header: decoder.header });
+      if (!job.headerSent) {
+        job.header = decoder.header;
+        if (job.header?.labels) sendHeader();
       }
       if (decoder.progress.chunksApplied !== before) job.changed = true;
     } else if (job.ending) {
@@ -296,7 +310,9 @@ function schedule() {
 
 async function start({ wasm, limits, coarsePlacement, tetrahedra, geomorph, normals }) {
   const current = (job = {
-    decoder: null, done: false, wanted: true, changed: false, headerSent: false, pending: [], ending: false, pumping: false,
+    decoder: null, done: false, wanted: true, changed: false, pending: [], ending: false, pumping: false,
+    header: null, headerSent: false,  // the header as last read, and whether the page has it (see sendHeader())
+    labels: null, labelIndex: null,   // the label table, and each label's index in it (see orderByLabel())
     decodeMs: 0, handOverMs: 0,  // decoding since the last snapshot, and that snapshot's cost (snapshotDue())
     wireframe: tetrahedra === 'wireframe',  // also send the edges of the tetrahedra
     geomorph: Boolean(geomorph),            // also send every vertex's parent

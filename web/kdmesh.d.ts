@@ -49,6 +49,10 @@ export interface Header {
   attributeCount: number;
   /** Whether edges, triangles and tetrahedra carry integer labels (Model.labels). */
   labelled: boolean;
+  /** The stream's label table, once it has arrived (right after the header and the attribute table): its
+   * distinct labels, ascending. A label's index here is the same at every level (kdmesh/three's
+   * materialIndex). null until then; empty for streams without labels. */
+  labels: Int32Array | null;
 }
 
 /**

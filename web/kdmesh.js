@@ -227,12 +227,24 @@ export class Decoder {
     this.#check(m._kdm_finish(this.#handle));
   }
 
-  /** Header fields once the header (at most 87 bytes) has arrived, else null. */
+  /**
+   * Header fields once the header (at most 87 bytes) has arrived, else null;
+   * with `labels`, the stream's label table once it has arrived (it follows
+   * the header and the attribute table): an Int32Array of the stream's
+   * distinct simplex labels, ascending, where a label's index is the same at
+   * every level (a material index for it). null until then, empty for
+   * streams without labels. A copy.
+   */
   get header() {
     const m = this.#live();
-    if (!m._kdm_has_header(this.#handle)) return null;
-    m._kdm_header(this.#handle, this.#scratch);
-    return readRecord(m.records.header, this.#doubles(m.records.header.size));
+    const h = this.#handle;
+    if (!m._kdm_has_header(h)) return null;
+    m._kdm_header(h, this.#scratch);
+    const header = readRecord(m.records.header, this.#doubles(m.records.header.size));
+    // A labelled stream's table holds at least one label: none yet means not arrived.
+    const count = m._kdm_table_label_count(h);
+    header.labels = count || !header.labelled ? new Int32Array(m.HEAPU8.buffer, m._kdm_table_labels(h), count).slice() : null;
+    return header;
   }
 
   /** { bytesReceived, bytesConsumed, bytesExpected, chunksApplied, level, vertexCount, complete, errorBound } */

@@ -10,7 +10,7 @@ export interface LabelGroup {
   /** First index of the range, and indices in it (3 per triangle). */
   start: number;
   count: number;
-  /** The label's rank among the level's distinct labels, ascending from 0. */
+  /** The label's index in the stream's label table (Header.labels): the same at every level. */
   materialIndex: number;
   label: number;
 }
@@ -23,7 +23,8 @@ export interface StreamedModel extends Model {
    * label (boundary triangles with their tetrahedron's label), each label's in their order in those lists. */
   surface: Uint32Array;
   /** Labelled streams: one group per distinct label of the surface's triangles, in ascending label order,
-   * covering `surface`; empty otherwise. Edge labels make no groups. */
+   * covering `surface` (a label of the stream absent from the level has none); empty otherwise. Edge
+   * labels make no groups. */
   groups: LabelGroup[];
   /** Edges of the tetrahedra ('wireframe'), stored right after `edges`. */
   tetrahedronEdges: Uint32Array;
@@ -76,7 +77,8 @@ export interface ProgressiveOptions extends LoadOptions<Group> {
   geomorphFrames?: number;
   onAnimate?: (object: Group) => void;
   /** The surface Mesh's material instead of `materials.surface`: an array draws the triangles of each simplex
-   * label with the material at the label's rank (the geometry's groups; userData.labels names the labels). */
+   * label with the material at the label's index in Header.labels (the geometry's groups; userData.labels
+   * is that table). */
   materials?: Material | Material[];
 }
 
@@ -89,9 +91,9 @@ export interface ModelUserData {
 export interface GeometryUserData extends ModelUserData {
   /** What the index holds, once the header has arrived. */
   primitive?: 'triangles' | 'lines' | 'points';
-  /** Labelled triangles: labels[materialIndex], the label of each group (ascending), for the level drawn
-   * (loadProgressive's surface geometry has the same). */
-  labels?: number[];
+  /** Labelled triangles: the stream's label table (Header.labels), labels[materialIndex] the label of a
+   * group's triangles, the same at every level (loadProgressive's surface geometry has the same). */
+  labels?: Int32Array;
 }
 
 /** Tells without waiting whether the GPU has finished the work issued before the last set(). */

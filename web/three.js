@@ -231,15 +231,18 @@ const listsOf = (model) => [
 ];
 
 // A labelled stream's surface geometry gets the level's groups, one per
-// distinct label in ascending order (materialIndex: the label's rank), and
-// userData.labels, the label of each materialIndex: a Mesh with an array
-// of materials draws each label with its own, as three.js's loaders do for
-// materials. Streams without labels leave the geometry's groups alone.
-function setLabelGroups(geometry, model) {
+// label its triangles have, in ascending order, materialIndex the label's
+// index in the stream's label table `labels` (the header's: every label of
+// the stream, ascending, so a label keeps its materialIndex at every level,
+// whichever labels a level lacks), and userData.labels, that table (the
+// label of each materialIndex): a Mesh with an array of materials draws
+// each label with its own, as three.js's loaders do for materials. Streams
+// without labels leave the geometry's groups alone.
+function setLabelGroups(geometry, model, labels) {
   if (!model.labels) return;
   geometry.clearGroups();
   for (const { start, count, materialIndex } of model.groups) geometry.addGroup(start, count, materialIndex);
-  geometry.userData.labels = model.groups.map((group) => group.label);
+  geometry.userData.labels = labels;
 }
 
 // Vertex colours come as files store them, in sRGB (PLY's red, green and
@@ -284,6 +287,11 @@ class GroupView {
     this.previous = null;     // { positions, count } of the last level drawn
     this.morphTarget = null;  // { start, positions, count } for a geomorph of the level staged
     this.morphId = 0;
+    this.labels = null;       // the stream's label table (see setLabelGroups)
+  }
+
+  header(header) {
+    this.labels = header.labels;
   }
 
   // Draws `model` (after at least one frame); false when `stopped()` became
@@ -356,7 +364,7 @@ class GroupView {
       const count = first.length + more;
       if (count) this.back.stage(INDEX, i, storageOf(first), count, 1);
       const geometry = this.back.geometries[i];
-      if (i === 0) setLabelGroups(geometry, model);
+      if (i === 0) setLabelGroups(geometry, model, this.labels);
       geometry.boundingBox = box.clone();
       geometry.boundingSphere = sphere.clone();
     });
@@ -414,9 +422,11 @@ class GeometryView {
     this.object = geometry;
     this.attributes = attributes;
     this.list = -1;  // which of listsOf() the index holds (-1: none)
+    this.labels = null;  // the stream's label table (see setLabelGroups)
   }
 
   header(header) {
+    this.labels = header.labels;
     const [, edges, triangles, tetrahedra] = header.simplexCounts;
     this.list = triangles + tetrahedra > 0 ? 0 : edges > 0 ? 1 : -1;
     this.object.userData.primitive = ['triangles', 'lines'][this.list] ?? 'points';
@@ -440,7 +450,7 @@ class GeometryView {
       const [first, more] = listsOf(model)[this.list];
       count = first.length + more;
       if (count) update(INDEX, storageOf(first), count, 1);
-      if (this.list === 0) setLabelGroups(geometry, model);
+      if (this.list === 0) setLabelGroups(geometry, model, this.labels);
     }
     geometry.setDrawRange(0, count);
     geometry.boundingBox = new Box3().setFromArray(model.bounds);
@@ -655,8 +665,8 @@ export class KDMeshLoader extends Loader {
    * geomorphFrames frames, default 12), onAnimate(model) whenever the model
    * changes between refinements (geomorph frames), materials (the surface
    * Mesh's material instead of loader.materials.surface: an array draws the
-   * triangles of each simplex label with the material of the label's rank,
-   * see setLabelGroups).
+   * triangles of each simplex label with the material at the label's index
+   * in header.labels, see setLabelGroups).
    */
   loadProgressive(url, options = {}) {
     const model = this.#createGroup(options.materials);

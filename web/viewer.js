@@ -17,8 +17,9 @@ const viewer = (window.kdmeshViewer = {
   pointCount: 0, bytesReceived: 0, bytesExpected: 0, level: 0, error: null, firstRenderMs: null,
   // Names of the model's vertex attributes ('color' draws as vertex colours).
   attributes: [],
-  // A stream with simplex labels: the labels of the level drawn, ascending
-  // (one per surface group), and whether the surface is coloured by them.
+  // A stream with simplex labels: its labels, ascending (header.labels:
+  // the label of each materialIndex), and whether the surface is coloured
+  // by them.
   labelled: false, labels: [], colouredByLabel: false,
   // A glTF scene: its compressed primitives (streams) and those complete.
   streams: 0, streamsComplete: 0,
@@ -188,22 +189,19 @@ function fitFog() {
 }
 
 // Colouring by label: the surface Mesh draws each label group with a
-// material of a fixed palette. A label keeps the colour it got when it first
-// appeared (the next of the palette, cycling; not its rank, which changes
-// when a finer level brings a new label), so that a region keeps its colour
-// from level to level. One material per palette colour, made on first use.
+// material of a fixed palette, chosen by the group's materialIndex (the
+// label's index in the stream's label table, the same at every level), so
+// that a region keeps its colour from level to level. One material per
+// palette colour, made on first use.
 const labelPalette = [0x4e79a7, 0xf28e2b, 0xe15759, 0x76b7b2, 0x59a14f, 0xedc948, 0xb07aa1, 0xff9da7, 0x9c755f, 0xbab0ac];
-const labelColours = new Map();  // label -> palette colour, for the current model
-const labelMaterials = new Map();  // palette colour -> material
-function labelMaterial(label) {
-  if (!labelColours.has(label)) labelColours.set(label, labelPalette[labelColours.size % labelPalette.length]);
-  const colour = labelColours.get(label);
-  if (!labelMaterials.has(colour)) {
-    const material = loader.materials.surface.clone();
-    material.color.set(colour);
-    labelMaterials.set(colour, material);
+const labelMaterials = [];  // palette index -> material
+function labelMaterial(materialIndex) {
+  const colour = materialIndex % labelPalette.length;
+  if (!labelMaterials[colour]) {
+    labelMaterials[colour] = loader.materials.surface.clone();
+    labelMaterials[colour].color.set(labelPalette[colour]);
   }
-  return labelMaterials.get(colour);
+  return labelMaterials[colour];
 }
 
 // The surface of the current model coloured by label when the toggle is on
@@ -216,7 +214,7 @@ function colourByLabel() {
   const on = $('labels').checked && Boolean(labels?.length);
   if (on) {
     if (!Array.isArray(surface.material)) surface.userData.ownMaterial = surface.material;
-    surface.material = labels.map(labelMaterial);
+    surface.material = Array.from(labels, (label, materialIndex) => labelMaterial(materialIndex));
   } else if (surface.userData.ownMaterial) {
     surface.material = surface.userData.ownMaterial;
     delete surface.userData.ownMaterial;
@@ -303,7 +301,6 @@ function start(load) {
     labelled: false, labels: [], colouredByLabel: false,
   });
   $('labels-option').hidden = true;
-  labelColours.clear();
   pendingStatus = pendingProgress = null;
   $('progress').value = $('decoded').value = 0;
   showStatus('loading…');
@@ -319,7 +316,9 @@ function start(load) {
     onAnimate: requestRender,
     onHeader(header) {
       if (!isCurrent()) return;
-      Object.assign(viewer, { levelCount: header.depth, vertexTotal: header.vertexCount, labelled: header.labelled });
+      Object.assign(viewer, {
+        levelCount: header.depth, vertexTotal: header.vertexCount, labelled: header.labelled, labels: Array.from(header.labels ?? []),
+      });
       $('labels-option').hidden = !header.labelled;  // offered only for models with labels
     },
     onProgress(stats) {
@@ -334,7 +333,7 @@ function start(load) {
       Object.assign(viewer, {
         refinements: stats.refinements, vertexCount: m.vertexCount, triangleCount: m.triangles.length / 3,
         tetrahedronCount: m.tetrahedra.length / 4, edgeCount: m.edges.length / 2, pointCount: m.points.length,
-        level: m.progress.level, attributes: Object.keys(m.attributes), labels: m.groups.map((group) => group.label),
+        level: m.progress.level, attributes: Object.keys(m.attributes),
       });
       colourByLabel();
       if (!viewer.levelsSeen.includes(m.progress.level)) viewer.levelsSeen.push(m.progress.level);

@@ -453,7 +453,8 @@ test('labels become geometry groups: a material array draws each label with its 
         levels.push({
           groups: geometry.groups.map(({ start, count, materialIndex }) => ({ start, count, materialIndex })),
           expected: stats.model.groups.map(({ start, count, materialIndex }) => ({ start, count, materialIndex })),
-          labels: geometry.userData.labels, modelLabels: stats.model.groups.map((g) => g.label),
+          labels: Array.from(geometry.userData.labels), header: Array.from(stats.header.labels),
+          modelLabels: stats.model.groups.map((g) => g.label),
           drawCount: geometry.drawRange.count, surface: stats.model.surface.length,
         });
       },
@@ -477,7 +478,7 @@ test('labels become geometry groups: a material array draws each label with its 
     renderer.dispose();
     return {
       levels, drawn, single, own, sameMaterial: material === materials,
-      geometryGroups: geometry.groups.length, geometryLabels: geometry.userData.labels,
+      geometryGroups: geometry.groups.length, geometryLabels: Array.from(geometry.userData.labels),
       plain: { groups: plain.children[0].geometry.groups.length, labels: plain.children[0].geometry.userData.labels ?? null },
     };
   });
@@ -485,16 +486,18 @@ test('labels become geometry groups: a material array draws each label with its 
   for (const level of result.levels) {
     // Every level's groups are the worker's, and cover what is drawn.
     assert.deepEqual(level.groups, level.expected, JSON.stringify(level));
-    assert.deepEqual(level.labels, level.modelLabels, JSON.stringify(level));
+    // userData.labels is the header's table at every level, each group's label at its materialIndex.
+    assert.deepEqual(level.labels, [-2, 5], JSON.stringify(level));
+    assert.deepEqual(level.header, [-2, 5], JSON.stringify(level));
+    assert.deepEqual(level.groups.map((g) => level.labels[g.materialIndex]), level.modelLabels, JSON.stringify(level));
     assert.equal(level.groups.reduce((sum, g) => sum + g.count, 0), level.drawCount, JSON.stringify(level));
     assert.equal(level.drawCount, level.surface);
   }
   const last = result.levels.at(-1);
-  assert.deepEqual(last.labels, [-2, 5]);
   const counts = [-2, 5].map((label) => 3 * decoded.labels.triangles.filter((l) => l === label).length);
   assert.deepEqual(last.groups, [{ start: 0, count: counts[0], materialIndex: 0 }, { start: counts[0], count: counts[1], materialIndex: 1 }]);
   assert.equal(result.sameMaterial, true);
-  // Label 5 (rank 1, green) on the left, -2 (rank 0, red) on the right.
+  // Label 5 (materialIndex 1, green) on the left, -2 (materialIndex 0, red) on the right.
   for (const drawn of [result.drawn, result.own]) {
     assert.ok(drawn.left.green > 1000 && drawn.left.red === 0, JSON.stringify(drawn));
     assert.ok(drawn.right.red > 1000 && drawn.right.green === 0, JSON.stringify(drawn));

@@ -68,6 +68,9 @@ test('a whole stream decodes with every triangle label', async () => {
   assert.equal(info.labels.distinct, 4);
 });
 
+// The input's distinct labels, ascending.
+const distinctLabels = (labels) => [...new Set(labels)].sort((a, b) => a - b);
+
 test('every prefix snapshot has one label per simplex, of the input labels', async () => {
   const decoder = await createDecoder();
   const inputLabels = new Set(shape.labels);
@@ -76,11 +79,29 @@ test('every prefix snapshot has one label per simplex, of the input labels', asy
     assert.equal(decoder.header?.labelled ?? true, true);
     const model = decoder.snapshot({ copy: false });
     if (!decoder.header) continue;
+    // The label table arrives with the first chunk, before any snapshot has a simplex.
+    if (decoder.progress.chunksApplied) assert.deepEqual(decoder.header.labels, Int32Array.from(distinctLabels(shape.labels)));
     assert.equal(model.labels.triangles.length, model.triangles.length / 3, `at ${at} bytes`);
     assert.equal(model.labels.edges.length, model.edges.length / 2, `at ${at} bytes`);
     for (const label of model.labels.triangles) assert.ok(inputLabels.has(label), `label ${label} at ${at} bytes`);
   }
   decoder.finish();
+  decoder.dispose();
+});
+
+test('the header gives the label table once it has arrived, byte by byte', async () => {
+  const decoder = await createDecoder();
+  const seen = [];  // header.labels after each byte, from the header's last
+  for (let at = 0; !decoder.header?.labels; ++at) {
+    decoder.push(bytes.subarray(at, at + 1));
+    if (decoder.header) seen.push(decoder.header.labels);
+  }
+  // null while the table's nine bytes (count, four labels, checksum) arrive.
+  assert.ok(seen.length >= 10, `bytes from the header's last to the table's: ${seen.length}`);
+  assert.ok(seen.slice(0, -1).every((labels) => labels === null));
+  assert.ok(seen.at(-1) instanceof Int32Array);
+  assert.deepEqual(Array.from(seen.at(-1)), [-1, 10, 20, 30]);
+  assert.equal(decoder.progress.chunksApplied, 0);
   decoder.dispose();
 });
 
@@ -92,6 +113,7 @@ test('streams without labels have no labels', async () => {
   const decoder = await createDecoder();
   decoder.push(readFileSync(out));
   assert.equal(decoder.header.labelled, false);
+  assert.deepEqual(decoder.header.labels, new Int32Array(0));
   assert.equal(decoder.snapshot().labels, undefined);
   decoder.dispose();
 });
@@ -99,7 +121,8 @@ test('streams without labels have no labels', async () => {
 // Runs the loader's worker in a Node worker thread, with the two globals of
 // a web worker it uses (postMessage, onmessage), streams `bytes` to it in
 // pieces of `piece` bytes a few milliseconds apart, asks for every level
-// as the page does, and resolves with the levels it handed over.
+// as the page does, and resolves with the header and the levels it handed
+// over.
 async function workerLevels(bytes, piece = 64) {
   const script = pathToFileURL(join(root, 'web', 'kdmesh-worker.js')).href;
   const worker = new Worker(`
@@ -111,12 +134,15 @@ async function workerLevels(bytes, piece = 64) {
   try {
     return await new Promise((resolve, reject) => {
       const levels = [];
+      let header = null;
       worker.on('error', reject);
       worker.on('message', async (data) => {
         if (data.type === 'error') reject(new Error(`${data.code}: ${data.message}`));
+        if (data.type === 'header') header = data.header;
         if (data.type === 'snapshot') {
+          if (!header) reject(new Error('a level came before the header'));
           levels.push(data.model);
-          if (data.model.complete) resolve(levels);
+          if (data.model.complete) resolve({ header, levels });
           else worker.postMessage({ type: 'next' });
         }
         if (data.type !== 'ready') return;
@@ -133,12 +159,14 @@ async function workerLevels(bytes, piece = 64) {
   }
 }
 
-// Checks a level's surface index and groups against its lists: the groups
-// cover the index exactly, one after the other, one per distinct label in
-// ascending order with its rank as materialIndex, and each holds exactly
-// the triangles drawn with its label (the triangles with theirs, then the
-// boundary of the tetrahedra with its tetrahedron's), in their order there.
-function assertLabelGroups(model, what) {
+// Checks a level's surface index and groups against its lists and the
+// stream's label table (the header's labels): the groups cover the index
+// exactly, one after the other, one per distinct label of the level in
+// ascending order with its index in the table as materialIndex (not its
+// rank among the level's labels), and each holds exactly the triangles
+// drawn with its label (the triangles with theirs, then the boundary of the
+// tetrahedra with its tetrahedron's), in their order there.
+function assertLabelGroups(model, table, what) {
   const drawn = [...model.triangles, ...model.boundary];
   assert.equal(model.surface.length, drawn.length, `${what}: surface length`);
   if (!model.labels) {
@@ -163,8 +191,9 @@ function assertLabelGroups(model, what) {
   const labels = [...byLabel.keys()].sort((a, b) => a - b);
   assert.deepEqual(model.groups.map((g) => g.label), labels, `${what}: one group per label, ascending`);
   let end = 0;
-  model.groups.forEach((group, rank) => {
-    assert.equal(group.materialIndex, rank, `${what}: materialIndex of label ${group.label}`);
+  model.groups.forEach((group) => {
+    assert.ok(table.includes(group.label), `${what}: label ${group.label} in the table`);
+    assert.equal(group.materialIndex, table.indexOf(group.label), `${what}: materialIndex of label ${group.label}`);
     assert.equal(group.start, end, `${what}: group of label ${group.label} starts where the last ended`);
     assert.deepEqual(Array.from(model.surface.subarray(group.start, group.start + group.count)), byLabel.get(group.label),
       `${what}: the triangles of label ${group.label}`);
@@ -177,11 +206,12 @@ function assertLabelGroups(model, what) {
 const labelCounts = (labels) => [...labels.reduce((m, l) => m.set(l, (m.get(l) ?? 0) + 1), new Map())].sort((a, b) => a[0] - b[0]);
 
 test('the loader\'s worker orders every level\'s triangles by label into groups', async () => {
-  const levels = await workerLevels(bytes);
+  const { header, levels } = await workerLevels(bytes);
+  assert.deepEqual(header.labels, Int32Array.from([-1, 10, 20, 30]));
   assert.ok(levels.length >= 5, `levels: ${levels.length}`);
   const counts = new Set();
   for (const [i, model] of levels.entries()) {
-    assertLabelGroups(model, `level ${i}`);
+    assertLabelGroups(model, header.labels, `level ${i}`);
     // As many triangles per group as the level's labels say.
     assert.deepEqual(model.groups.map((g) => [g.label, g.count / 3]), labelCounts(model.labels.triangles), `level ${i}`);
     counts.add(model.groups.length);
@@ -193,16 +223,35 @@ test('the loader\'s worker orders every level\'s triangles by label into groups'
   assert.deepEqual(levels.at(-1).groups.map((g) => g.label), [-1, 10, 20, 30]);
 });
 
+test('a label absent from coarse levels shifts no other label\'s materialIndex', async () => {
+  // The torus with one quad (the 101st, which the first chunks leave out)
+  // labelled -50, below every other label: with ranks among a level's
+  // labels, each other label's would grow by one once -50 first shows.
+  const spotted = labelledTorus();
+  spotted.labels[200] = spotted.labels[201] = -50;
+  const path = join(workDir, 'spotted-torus.ply');
+  writeLabelledPly(path, spotted);
+  const out = join(workDir, 'spotted-torus.kdm');
+  execFileSync(cli, ['encode', path, '-o', out, '--exact', '--chunk-bytes', '256', '-q']);
+  const { header, levels } = await workerLevels(readFileSync(out));
+  assert.deepEqual(Array.from(header.labels), [-50, -1, 10, 20, 30]);
+  const shows = levels.map((model) => model.groups.some((g) => g.label === -50));
+  assert.equal(shows[0], false, 'the coarsest level lacks label -50');
+  assert.equal(shows.at(-1), true);
+  for (const [i, model] of levels.entries()) assertLabelGroups(model, header.labels, `level ${i}`);
+});
+
 test('the boundary of labelled tetrahedra is grouped by the tetrahedra\'s labels', async () => {
   const block = labelledBlock();
   const path = join(workDir, 'labelled-block.ply');
   writeLabelledPly(path, block);
   const out = join(workDir, 'labelled-block.kdm');
   execFileSync(cli, ['encode', path, '-o', out, '--chunk-bytes', '256', '-q']);
-  const levels = await workerLevels(readFileSync(out));
+  const { header, levels } = await workerLevels(readFileSync(out));
+  assert.deepEqual(Array.from(header.labels), [-3, 7]);
   assert.ok(levels.length >= 3, `levels: ${levels.length}`);
   // Coarse levels may list triangles besides tetrahedra (collapsed ones).
-  for (const [i, model] of levels.entries()) assertLabelGroups(model, `level ${i}`);
+  for (const [i, model] of levels.entries()) assertLabelGroups(model, header.labels, `level ${i}`);
   const last = levels.at(-1);
   assert.equal(last.triangles.length, 0);
   assert.deepEqual(last.groups.map((g) => g.label), [-3, 7]);
@@ -215,7 +264,8 @@ test('the worker gives streams without labels no groups', async () => {
   writeLabelledPly(plain, shape, false);
   const out = join(workDir, 'unlabelled-torus-worker.kdm');
   execFileSync(cli, ['encode', plain, '-o', out, '--chunk-bytes', '256', '-q']);
-  const levels = await workerLevels(readFileSync(out));
+  const { header, levels } = await workerLevels(readFileSync(out));
+  assert.deepEqual(header.labels, new Int32Array(0));
   assert.ok(levels.length >= 3, `levels: ${levels.length}`);
-  for (const [i, model] of levels.entries()) assertLabelGroups(model, `level ${i}`);
+  for (const [i, model] of levels.entries()) assertLabelGroups(model, header.labels, `level ${i}`);
 });

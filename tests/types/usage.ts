@@ -24,6 +24,7 @@ export async function decoding(bytes: Uint8Array): Promise<number> {
   const quantized = coding === 'uniform' || coding === 'octahedral' ? coarse.attributes.normal.codingBits : 0;
   const attributeValues = (colour?.array.length ?? 0) + (colour?.itemSize ?? 0) + (header?.attributeCount ?? 0) + quantized;
   const regions: Int32Array | undefined = header?.labelled ? coarse.labels?.triangles : undefined;
+  const table: Int32Array | null = header?.labels ?? null;
   decoder.finish();
   decoder.dispose();
   try {
@@ -32,7 +33,8 @@ export async function decoding(bytes: Uint8Array): Promise<number> {
     if (error instanceof KdmeshError) return error.code.length;
   }
   return model.positions.length + progress.errorBound + (header?.simplexCounts[2] ?? 0) + coarse.triangles.length +
-    parents.length + attributeValues + (regions?.length ?? 0) + (await memoryInUse()) + (model.stats.bitsPerVertex > 0 ? 1 : 0);
+    parents.length + attributeValues + (regions?.length ?? 0) + (table?.length ?? 0) + (await memoryInUse()) +
+    (model.stats.bitsPerVertex > 0 ? 1 : 0);
 }
 
 export async function loading(renderer: WebGLRenderer): Promise<BufferGeometry> {
@@ -73,15 +75,16 @@ export async function loading(renderer: WebGLRenderer): Promise<BufferGeometry> 
   scene.add(new Mesh(geometry, new MeshNormalMaterial()));
   const primitive: 'triangles' | 'lines' | 'points' | undefined = geometry.userData.primitive;
   await geometry.userData.loaded;
-  // Simplex labels as groups: one material per label rank.
+  // Simplex labels as groups: one material per label of the stream's table.
   const byLabel = loader.loadProgressive('e.kdm', {
     materials: [new MeshBasicMaterial({ color: 0xff0000 }), new MeshBasicMaterial({ color: 0x00ff00 })],
     onRefine: (object: Group, stats: LoadStats) => {
       const groups: LabelGroup[] = stats.model?.groups ?? [];
-      return groups.every((g) => g.materialIndex >= 0 && g.start + g.count <= (stats.model?.surface.length ?? 0) && g.label !== 0.5);
+      return groups.every((g) =>
+        stats.header?.labels?.[g.materialIndex] === g.label && g.start + g.count <= (stats.model?.surface.length ?? 0));
     },
   });
-  const labels: number[] | undefined = geometry.userData.labels;
+  const labels: Int32Array | undefined = geometry.userData.labels;
   scene.add(byLabel);
   const fence = new GpuFence(renderer.getContext() as WebGL2RenderingContext);
   fence.set();
