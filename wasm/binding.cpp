@@ -195,6 +195,15 @@ EMSCRIPTEN_KEEPALIVE int kdm_attribute_components(KdmDecoder* d, uint32_t a) {
 EMSCRIPTEN_KEEPALIVE const uint8_t* kdm_attribute_values(KdmDecoder* d, uint32_t a) {
   return d->snapshot.attributes[a].values.data();
 }
+// How the stream codes attribute a: its kdmesh::AttributeQuantization::Kind
+// (exact, uniform, octahedral) and, for the lossy codings, the bits per
+// component (uniform) or per octahedral coordinate.
+EMSCRIPTEN_KEEPALIVE int kdm_attribute_coding(KdmDecoder* d, uint32_t a) {
+  return int(d->snapshot.attributes[a].quantization.kind);
+}
+EMSCRIPTEN_KEEPALIVE int kdm_attribute_coding_bits(KdmDecoder* d, uint32_t a) {
+  return int(d->snapshot.attributes[a].quantization.bits);
+}
 // The snapshot's labels of the simplices of dimension 1..3: as many as
 // simplices, or none when the stream has no labels.
 EMSCRIPTEN_KEEPALIVE uint32_t kdm_label_count(KdmDecoder* d, int dimension) {
@@ -203,6 +212,10 @@ EMSCRIPTEN_KEEPALIVE uint32_t kdm_label_count(KdmDecoder* d, int dimension) {
 EMSCRIPTEN_KEEPALIVE const int32_t* kdm_labels(KdmDecoder* d, int dimension) {
   return d->snapshot.labels.of(dimension).data();
 }
+// The stream's label table (Decoder::labels()): its distinct labels,
+// ascending; none until it has arrived or when the stream has no labels.
+EMSCRIPTEN_KEEPALIVE uint32_t kdm_table_label_count(KdmDecoder* d) { return uint32_t(d->decoder.labels().size()); }
+EMSCRIPTEN_KEEPALIVE const int32_t* kdm_table_labels(KdmDecoder* d) { return d->decoder.labels().data(); }
 EMSCRIPTEN_KEEPALIVE uint32_t kdm_parent_count(KdmDecoder* d) { return uint32_t(d->decoder.vertexParents().size()); }
 EMSCRIPTEN_KEEPALIVE const uint32_t* kdm_parents(KdmDecoder* d) { return d->decoder.vertexParents().data(); }
 

@@ -11,13 +11,16 @@
 //               normals? (false: compute none)}
 //               (a new stream), {type: 'bytes', bytes}, {type: 'end'},
 //               {type: 'next'} (the page is ready for a snapshot)
-// Messages out: {type: 'header', header}, {type: 'snapshot', model} (the
-//               last one has model.complete), {type: 'error', code, message}
+// Messages out: {type: 'header', header} (with header.labels, see sendHeader()),
+//               {type: 'snapshot', model} (the last one has model.complete),
+//               {type: 'error', code, message}
 //
 // A snapshot's arrays are sized for the final model, so that the page can
 // adopt them as GPU buffer storage: positions, normals and each vertex
-// attribute (model.attributes, name -> {array, itemSize}) in their own
-// storage, the lists of simplices packed (see pack()).
+// attribute (model.attributes, name -> {array, itemSize, ...}) in their own
+// storage, the lists of simplices packed (see pack()), and the surface's
+// index (model.surface) with, for labelled streams, its triangles ordered
+// by label into model.groups (see orderByLabel()).
 import { createDecoder, setWasmSource } from './kdmesh.js';
 
 let wasmSet = false;
@@ -25,6 +28,7 @@ let job = null;  // the stream being decoded (see start())
 
 // Faces of the tetrahedra that belong to exactly one: the visible surface of
 // a tetrahedral mesh, oriented outwards when the tetrahedra are positive.
+// `owners[i]` is the tetrahedron of face i (whose label the face shows).
 function boundaryOfTetrahedra(tetrahedra) {
   const faces = new Map();
   const corners = [[1, 2, 3], [0, 3, 2], [0, 1, 3], [0, 2, 1]];
@@ -33,13 +37,58 @@ function boundaryOfTetrahedra(tetrahedra) {
       const face = [tetrahedra[t + a], tetrahedra[t + b], tetrahedra[t + c]];
       const key = face.slice().sort((x, y) => x - y).join(',');
       if (faces.has(key)) faces.delete(key);
-      else faces.set(key, face);
+      else faces.set(key, { face, owner: t / 4 });
     }
   }
-  const out = new Uint32Array(faces.size * 3);
+  const triangles = new Uint32Array(faces.size * 3);
+  const owners = new Uint32Array(faces.size);
   let i = 0;
-  for (const face of faces.values()) out.set(face, 3 * i++);
-  return out;
+  for (const { face, owner } of faces.values()) {
+    owners[i] = owner;
+    triangles.set(face, 3 * i++);
+  }
+  return { triangles, owners };
+}
+
+// The drawn triangles of a labelled stream (`triangles`, 3 indices each,
+// with `labels`, one per triangle) ordered by label for three.js's
+// geometry groups: in new storage of at least `capacity` elements (see
+// pack()), the triangles of each label in one range, in the order of the
+// stream's label table `table` (ascending), each label's triangles in their
+// order here (a stable counting sort: one pass to count, one to place).
+// `indexOf` maps each label to its index in the table; labels come in runs,
+// so a label like the last skips the look-up. Returns the ordered triangles
+// and one group per label the triangles have, { start, count } in indices,
+// materialIndex the label's index in the table (the same at every level,
+// whichever labels a level lacks), and the label.
+function orderByLabel(triangles, labels, table, indexOf, capacity) {
+  const indices = new Uint32Array(labels.length);
+  const counts = new Uint32Array(table.length);
+  let last = 0, index = -1;
+  for (let t = 0; t < labels.length; ++t) {
+    if (index < 0 || labels[t] !== last) {
+      last = labels[t];
+      index = indexOf.get(last);
+    }
+    indices[t] = index;
+    ++counts[index];
+  }
+  // Where each label's next triangle goes, in triangles: after those of
+  // every smaller label.
+  const next = new Uint32Array(table.length);
+  const groups = [];
+  for (let i = 0, start = 0; i < table.length; start += counts[i++]) {
+    next[i] = start;
+    if (counts[i]) groups.push({ start: 3 * start, count: 3 * counts[i], materialIndex: i, label: table[i] });
+  }
+  const storage = new Uint32Array(Math.max(triangles.length, capacity));
+  for (let t = 0; t < labels.length; ++t) {
+    const to = 3 * next[indices[t]]++;
+    storage[to] = triangles[3 * t];
+    storage[to + 1] = triangles[3 * t + 1];
+    storage[to + 2] = triangles[3 * t + 2];
+  }
+  return { surface: storage.subarray(0, triangles.length), groups };
 }
 
 // Area-weighted vertex normals of the triangles, for streams without normals
@@ -138,7 +187,8 @@ function sendSnapshot() {
   if (!decoder || !job.wanted || !job.changed || !snapshotDue()) return;
   const began = performance.now();
   const live = decoder.snapshot({ copy: false });  // views, valid until the next call on the decoder
-  const boundary = live.tetrahedra.length ? boundaryOfTetrahedra(live.tetrahedra) : new Uint32Array(0);
+  const { triangles: boundary, owners } = live.tetrahedra.length ? boundaryOfTetrahedra(live.tetrahedra)
+    : { triangles: new Uint32Array(0), owners: new Uint32Array(0) };
   const tetrahedronEdges = live.tetrahedra.length && wireframe ? edgesOfTetrahedra(live.tetrahedra) : new Uint32Array(0);
   // Capacities: the final maximal simplices and isolated vertices, and for
   // tetrahedra up to four boundary triangles and six edges each.
@@ -147,12 +197,24 @@ function sendSnapshot() {
   const [points] = pack(Uint32Array, [live.points], pointCount);
   const [edges, tetrahedronEdgesInPlace] = pack(Uint32Array, [live.edges, tetrahedronEdges],
     2 * (edgeCount + (wireframe ? 6 * tetrahedronCount : 0)));
-  const [triangles, boundaryInPlace] = pack(Uint32Array, [live.triangles, boundary], 3 * (triangleCount + 4 * tetrahedronCount));
+  // The surface's index: the triangles, then the boundary of the
+  // tetrahedra, in storage sized for the final model; for labelled streams
+  // that is the surface ordered by label (the boundary's triangles with
+  // their tetrahedra's labels), and `triangles` a copy in the decoder's order.
+  const surfaceCapacity = 3 * (triangleCount + 4 * tetrahedronCount);
+  const [triangles, boundaryInPlace] = pack(Uint32Array, [live.triangles, boundary], live.labels ? 0 : surfaceCapacity);
   const drawnTriangles = new Uint32Array(triangles.buffer, 0, triangles.length + boundary.length);  // both lists
+  let surface = drawnTriangles, groups = [];
+  if (live.labels) {
+    const drawnLabels = new Int32Array(drawnTriangles.length / 3);
+    drawnLabels.set(live.labels.triangles);
+    for (let i = 0; i < owners.length; ++i) drawnLabels[live.labels.triangles.length + i] = live.labels.tetrahedra[owners[i]];
+    ({ surface, groups } = orderByLabel(drawnTriangles, drawnLabels, job.labels, job.labelIndex, surfaceCapacity));
+  }
   // Each vertex attribute in storage of its own, sized like the positions'.
   const attributes = {};
-  for (const [name, { array, itemSize }] of Object.entries(live.attributes))
-    attributes[name] = { array: pack(array.constructor, [array], vertexCount * itemSize)[0], itemSize };
+  for (const [name, attribute] of Object.entries(live.attributes))
+    attributes[name] = { ...attribute, array: pack(attribute.array.constructor, [attribute.array], vertexCount * attribute.itemSize)[0] };
   // Simplex labels (labelled streams): copies, as the views into the
   // decoder's memory must not be posted (a view posts its whole buffer).
   const labels = live.labels && {
@@ -161,7 +223,7 @@ function sendSnapshot() {
   };
   const model = {
     ...live, positions, points, edges, triangles, tetrahedra: live.tetrahedra.slice(), attributes, labels,
-    boundary: boundaryInPlace, tetrahedronEdges: tetrahedronEdgesInPlace,
+    boundary: boundaryInPlace, tetrahedronEdges: tetrahedronEdgesInPlace, surface, groups,
     bounds: bounds(positions),
     normals: streamNormals(attributes) ??
       (drawnTriangles.length && job.normals ? vertexNormals(positions, drawnTriangles) : new Float32Array(0)),
@@ -172,7 +234,7 @@ function sendSnapshot() {
   job.changed = false;
   job.decodeMs = 0;
   job.handOverMs = performance.now() - began;
-  const buffers = [positions, points, edges, triangles, model.tetrahedra, model.normals, model.parents,
+  const buffers = [positions, points, edges, triangles, surface, model.tetrahedra, model.normals, model.parents,
     ...Object.values(attributes).map((a) => a.array), ...(labels ? Object.values(labels) : [])]
     .map((a) => a.buffer).filter((b, i, all) => b.byteLength && all.indexOf(b) === i);
   postMessage({ type: 'snapshot', model }, buffers);
@@ -187,7 +249,22 @@ function end() {
   job.done = true;
 }
 
+// The header goes to the page once the stream's label table (header.labels,
+// after the header and the attribute table) has arrived too, so that the
+// page knows every label's materialIndex before the first level; a stream
+// that fails before the table sends it without (labels null) first.
+function sendHeader() {
+  const { header } = job;
+  job.headerSent = true;
+  if (header.labels) {
+    job.labels = header.labels;
+    job.labelIndex = new Map(Array.from(header.labels, (label, index) => [label, index]));
+  }
+  postMessage({ type: 'header', header });
+}
+
 function fail(error) {
+  if (job.header && !job.headerSent) sendHeader();
   postMessage({ type: 'error', code: error.code ?? 'error', message: error.message ?? String(error) });
   end();
 }
@@ -207,9 +284,9 @@ function pump(current) {
       const began = performance.now();
       decoder.push(pending.shift());
       job.decodeMs += performance.now() - began;
-      if (!job.headerSent && decoder.header) {
-        job.headerSent = true;
-        postMessage({ type: 'header', header: decoder.header });
+      if (!job.headerSent) {
+        job.header = decoder.header;
+        if (job.header?.labels) sendHeader();
       }
       if (decoder.progress.chunksApplied !== before) job.changed = true;
     } else if (job.ending) {
@@ -233,7 +310,9 @@ function schedule() {
 
 async function start({ wasm, limits, coarsePlacement, tetrahedra, geomorph, normals }) {
   const current = (job = {
-    decoder: null, done: false, wanted: true, changed: false, headerSent: false, pending: [], ending: false, pumping: false,
+    decoder: null, done: false, wanted: true, changed: false, pending: [], ending: false, pumping: false,
+    header: null, headerSent: false,  // the header as last read, and whether the page has it (see sendHeader())
+    labels: null, labelIndex: null,   // the label table, and each label's index in it (see orderByLabel())
     decodeMs: 0, handOverMs: 0,  // decoding since the last snapshot, and that snapshot's cost (snapshotDue())
     wireframe: tetrahedra === 'wireframe',  // also send the edges of the tetrahedra
     geomorph: Boolean(geomorph),            // also send every vertex's parent

@@ -45,16 +45,31 @@ export interface Header {
   /** Levels of the kd-tree: `progress.level` reaches it when the stream is complete (and goes past it
    * while coincident vertices of meshes and of attribute streams split apart). */
   depth: number;
-  /** Vertex attributes the stream carries (their names arrive with the first snapshot). */
+  /** Vertex attributes the stream carries (their names and codings arrive with the first snapshot's `attributes`). */
   attributeCount: number;
   /** Whether edges, triangles and tetrahedra carry integer labels (Model.labels). */
   labelled: boolean;
+  /** The stream's label table, once it has arrived (right after the header and the attribute table): its
+   * distinct labels, ascending. A label's index here is the same at every level (kdmesh/three's
+   * materialIndex). null until then; empty for streams without labels. */
+  labels: Int32Array | null;
 }
+
+/**
+ * How a stream codes a vertex attribute (`kdmesh info` names the same): 'exact' keeps every bit;
+ * 'uniform' quantizes each float32 component to codingBits bits over its range (encoder option
+ * --attr-bits); 'octahedral' codes a float32 × 3 'normal' as unit vectors in two codingBits-bit
+ * octahedral coordinates (--normal-bits). The decoded values are float32 either way.
+ */
+export type AttributeCoding = 'exact' | 'uniform' | 'octahedral';
 
 /** A vertex attribute's values: vertexCount · itemSize of its type, as a three.js BufferAttribute takes them. */
 export interface VertexAttribute {
   array: Uint8Array | Int8Array | Uint16Array | Int16Array | Uint32Array | Int32Array | Float32Array;
   itemSize: number;
+  coding: AttributeCoding;
+  /** Bits per component ('uniform') or per octahedral coordinate ('octahedral'); 0 when 'exact'. */
+  codingBits: number;
 }
 
 export interface Progress {

@@ -133,6 +133,9 @@ function loadModule() {
 const EMPTY_INDICES = new Uint32Array(0);
 // Typed arrays of kdmesh::AttributeType's values, in its order.
 const ATTRIBUTE_ARRAYS = [Uint8Array, Int8Array, Uint16Array, Int16Array, Uint32Array, Int32Array, Float32Array];
+// Names of kdmesh::AttributeQuantization::Kind's values, in its order (as
+// `kdmesh info` names them).
+const ATTRIBUTE_CODINGS = ['exact', 'uniform', 'octahedral'];
 
 const limitNames = ['maxVertices', 'maxSimplices', 'maxChunkBytes', 'maxVerticesPerByte', 'maxSimplicesPerByte'];
 
@@ -224,12 +227,24 @@ export class Decoder {
     this.#check(m._kdm_finish(this.#handle));
   }
 
-  /** Header fields once the header (at most 87 bytes) has arrived, else null. */
+  /**
+   * Header fields once the header (at most 87 bytes) has arrived, else null;
+   * with `labels`, the stream's label table once it has arrived (it follows
+   * the header and the attribute table): an Int32Array of the stream's
+   * distinct simplex labels, ascending, where a label's index is the same at
+   * every level (a material index for it). null until then, empty for
+   * streams without labels. A copy.
+   */
   get header() {
     const m = this.#live();
-    if (!m._kdm_has_header(this.#handle)) return null;
-    m._kdm_header(this.#handle, this.#scratch);
-    return readRecord(m.records.header, this.#doubles(m.records.header.size));
+    const h = this.#handle;
+    if (!m._kdm_has_header(h)) return null;
+    m._kdm_header(h, this.#scratch);
+    const header = readRecord(m.records.header, this.#doubles(m.records.header.size));
+    // A labelled stream's table holds at least one label: none yet means not arrived.
+    const count = m._kdm_table_label_count(h);
+    header.labels = count || !header.labelled ? new Int32Array(m.HEAPU8.buffer, m._kdm_table_labels(h), count).slice() : null;
+    return header;
   }
 
   /** { bytesReceived, bytesConsumed, bytesExpected, chunksApplied, level, vertexCount, complete, errorBound } */
@@ -244,8 +259,13 @@ export class Decoder {
    * triangles, tetrahedra, attributes, labels?, complete, stats }. `labels`
    * (streams with simplex labels only) holds { edges, triangles, tetrahedra },
    * an Int32Array of one label per simplex of each list. `attributes` maps
-   * each vertex attribute's name to { array, itemSize } (a typed array of
-   * vertexCount · itemSize values, the type's own: Uint8Array for uint8, ...). With { copy: false } the arrays
+   * each vertex attribute's name to { array, itemSize, coding, codingBits }:
+   * a typed array of vertexCount · itemSize values, the type's own
+   * (Uint8Array for uint8, ...), and how the stream codes them: 'exact'
+   * (codingBits 0), 'uniform' (float32 quantized to codingBits bits per
+   * component over its range, the encoder's --attr-bits) or 'octahedral'
+   * (unit normals as two codingBits-bit octahedral coordinates,
+   * --normal-bits). With { copy: false } the arrays
    * are views of WebAssembly memory, valid only until the next call on this
    * decoder; by default they are copies the caller may keep.
    */
@@ -261,13 +281,16 @@ export class Decoder {
       return count ? take(new Uint32Array(m.HEAPU8.buffer, m._kdm_indices(h, dimension), count)) : EMPTY_INDICES;
     };
     // Vertex attributes by name: { array, itemSize }, as a three.js
-    // BufferAttribute takes them.
+    // BufferAttribute takes them, with how the stream codes them (coding,
+    // codingBits: 0 when exact).
     const attributes = {};
     for (let a = 0, count = m._kdm_attribute_count(h); a < count; ++a) {
       const Type = ATTRIBUTE_ARRAYS[m._kdm_attribute_type(h, a)];
       const itemSize = m._kdm_attribute_components(h, a);
       const array = take(new Type(m.HEAPU8.buffer, m._kdm_attribute_values(h, a), vertexCount * itemSize));
-      attributes[m.UTF8ToString(m._kdm_attribute_name(h, a))] = { array, itemSize };
+      attributes[m.UTF8ToString(m._kdm_attribute_name(h, a))] = {
+        array, itemSize, coding: ATTRIBUTE_CODINGS[m._kdm_attribute_coding(h, a)], codingBits: m._kdm_attribute_coding_bits(h, a),
+      };
     }
     const progress = this.progress;
     const model = {

@@ -1,14 +1,31 @@
 // Type declarations for kdmesh/three (web/three.js).
 import {
-  BufferGeometry, Camera, Group, LineBasicMaterial, Loader, LoadingManager, MeshStandardMaterial, PointsMaterial, Scene,
+  BufferGeometry, Camera, Group, LineBasicMaterial, Loader, LoadingManager, Material, MeshStandardMaterial, PointsMaterial, Scene,
   WebGLRenderer,
 } from 'three';
 import { DecoderLimits, Header, Model, Progress, WasmSource } from 'kdmesh';
+
+/** The triangles of one simplex label in the surface's index, as BufferGeometry.addGroup takes them. */
+export interface LabelGroup {
+  /** First index of the range, and indices in it (3 per triangle). */
+  start: number;
+  count: number;
+  /** The label's index in the stream's label table (Header.labels): the same at every level. */
+  materialIndex: number;
+  label: number;
+}
 
 /** A level as the worker hands it over: the Model's lists plus what drawing needs. */
 export interface StreamedModel extends Model {
   /** Boundary triangles of the tetrahedra, stored right after `triangles`. */
   boundary: Uint32Array;
+  /** The surface's index: `triangles` then `boundary`; for labelled streams the same triangles ordered by
+   * label (boundary triangles with their tetrahedron's label), each label's in their order in those lists. */
+  surface: Uint32Array;
+  /** Labelled streams: one group per distinct label of the surface's triangles, in ascending label order,
+   * covering `surface` (a label of the stream absent from the level has none); empty otherwise. Edge
+   * labels make no groups. */
+  groups: LabelGroup[];
   /** Edges of the tetrahedra ('wireframe'), stored right after `edges`. */
   tetrahedronEdges: Uint32Array;
   /** [minX, minY, minZ, maxX, maxY, maxZ] */
@@ -59,6 +76,10 @@ export interface ProgressiveOptions extends LoadOptions<Group> {
   geomorph?: boolean;
   geomorphFrames?: number;
   onAnimate?: (object: Group) => void;
+  /** The surface Mesh's material instead of `materials.surface`: an array draws the triangles of each simplex
+   * label with the material at the label's index in Header.labels (the geometry's groups; userData.labels
+   * is that table). */
+  materials?: Material | Material[];
 }
 
 export interface ModelUserData {
@@ -70,6 +91,9 @@ export interface ModelUserData {
 export interface GeometryUserData extends ModelUserData {
   /** What the index holds, once the header has arrived. */
   primitive?: 'triangles' | 'lines' | 'points';
+  /** Labelled triangles: the stream's label table (Header.labels), labels[materialIndex] the label of a
+   * group's triangles, the same at every level (loadProgressive's surface geometry has the same). */
+  labels?: Int32Array;
 }
 
 /** Tells without waiting whether the GPU has finished the work issued before the last set(). */

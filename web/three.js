@@ -20,7 +20,10 @@
 // become geometry attributes of the same names ('color', 'normal', 'uv',
 // and any other under its own name, see vertexAttributesOf()), refined in
 // place like the positions; a model with a 'color' draws with vertex
-// colours (materials the page supplies need vertexColors set). `await
+// colours (materials the page supplies need vertexColors set). A stream
+// with simplex labels draws its triangles ordered by label, one geometry
+// group per label (see setLabelGroups), so that a surface Mesh with an
+// array of materials draws each label with its own. `await
 // loader.prepareRenderer(renderer, camera, scene)` before streaming keeps
 // the first refinements from blocking the page.
 import {
@@ -218,12 +221,29 @@ function createBuffersFromUsedBytes(gl) {
 
 // What a model's geometry draws from a level: its lists of simplices, each
 // [first list, elements of the second list stored right after it] (see the
-// worker's pack()), for the surface, the lines and the points.
+// worker's pack()), for the surface (one list: the triangles with the
+// boundary of the tetrahedra, ordered by label for labelled streams), the
+// lines and the points.
 const listsOf = (model) => [
-  [model.triangles, model.boundary.length],
+  [model.surface, 0],
   [model.edges, model.tetrahedronEdges.length],
   [model.points, 0],
 ];
+
+// A labelled stream's surface geometry gets the level's groups, one per
+// label its triangles have, in ascending order, materialIndex the label's
+// index in the stream's label table `labels` (the header's: every label of
+// the stream, ascending, so a label keeps its materialIndex at every level,
+// whichever labels a level lacks), and userData.labels, that table (the
+// label of each materialIndex): a Mesh with an array of materials draws
+// each label with its own, as three.js's loaders do for materials. Streams
+// without labels leave the geometry's groups alone.
+function setLabelGroups(geometry, model, labels) {
+  if (!model.labels) return;
+  geometry.clearGroups();
+  for (const { start, count, materialIndex } of model.groups) geometry.addGroup(start, count, materialIndex);
+  geometry.userData.labels = labels;
+}
 
 // Vertex colours come as files store them, in sRGB (PLY's red, green and
 // blue), and three.js takes them as linear: `material`'s vertex shader
@@ -267,6 +287,11 @@ class GroupView {
     this.previous = null;     // { positions, count } of the last level drawn
     this.morphTarget = null;  // { start, positions, count } for a geomorph of the level staged
     this.morphId = 0;
+    this.labels = null;       // the stream's label table (see setLabelGroups)
+  }
+
+  header(header) {
+    this.labels = header.labels;
   }
 
   // Draws `model` (after at least one frame); false when `stopped()` became
@@ -339,6 +364,7 @@ class GroupView {
       const count = first.length + more;
       if (count) this.back.stage(INDEX, i, storageOf(first), count, 1);
       const geometry = this.back.geometries[i];
+      if (i === 0) setLabelGroups(geometry, model, this.labels);
       geometry.boundingBox = box.clone();
       geometry.boundingSphere = sphere.clone();
     });
@@ -385,7 +411,8 @@ class GroupView {
 // material and object: its index holds the triangles (with the boundary of
 // tetrahedra) when the complete model has any, else its edges; a point
 // cloud has no index. userData.primitive ('triangles', 'lines' or
-// 'points') says which, once the header has arrived.
+// 'points') says which, once the header has arrived. Labelled triangles
+// come with groups and userData.labels (see setLabelGroups).
 //
 // `attributes`, when given, names the geometry attribute of each stream
 // attribute, { [streamName]: { name, normalized } }: those alone are set,
@@ -395,9 +422,11 @@ class GeometryView {
     this.object = geometry;
     this.attributes = attributes;
     this.list = -1;  // which of listsOf() the index holds (-1: none)
+    this.labels = null;  // the stream's label table (see setLabelGroups)
   }
 
   header(header) {
+    this.labels = header.labels;
     const [, edges, triangles, tetrahedra] = header.simplexCounts;
     this.list = triangles + tetrahedra > 0 ? 0 : edges > 0 ? 1 : -1;
     this.object.userData.primitive = ['triangles', 'lines'][this.list] ?? 'points';
@@ -421,6 +450,7 @@ class GeometryView {
       const [first, more] = listsOf(model)[this.list];
       count = first.length + more;
       if (count) update(INDEX, storageOf(first), count, 1);
+      if (this.list === 0) setLabelGroups(geometry, model, this.labels);
     }
     geometry.setDrawRange(0, count);
     geometry.boundingBox = new Box3().setFromArray(model.bounds);
@@ -550,12 +580,13 @@ export class KDMeshLoader extends Loader {
   }
 
   // The objects of one model: their geometries are the model's own, the
-  // materials the loader's.
-  #createGroup() {
+  // materials the loader's, or the surface's `materials` (an array: one per
+  // label group, see setLabelGroups).
+  #createGroup(materials = this.materials.surface) {
     const group = new Group();
     group.name = 'kdmesh';
-    const { surface, lines, points } = this.materials;
-    group.add(new Mesh(new BufferGeometry(), surface), new LineSegments(new BufferGeometry(), lines),
+    const { lines, points } = this.materials;
+    group.add(new Mesh(new BufferGeometry(), materials), new LineSegments(new BufferGeometry(), lines),
       new Points(new BufferGeometry(), points));
     return group;
   }
@@ -632,10 +663,13 @@ export class KDMeshLoader extends Loader {
    * 'wireframe' (the boundary plus every edge of the tetrahedra), geomorph
    * (true: new vertices glide from their parent's position over
    * geomorphFrames frames, default 12), onAnimate(model) whenever the model
-   * changes between refinements (geomorph frames).
+   * changes between refinements (geomorph frames), materials (the surface
+   * Mesh's material instead of loader.materials.surface: an array draws the
+   * triangles of each simplex label with the material at the label's index
+   * in header.labels, see setLabelGroups).
    */
   loadProgressive(url, options = {}) {
-    const model = this.#createGroup();
+    const model = this.#createGroup(options.materials);
     this.#run(url, null, options, this.#groupView(model, options));
     return model;
   }

@@ -17,6 +17,10 @@ const viewer = (window.kdmeshViewer = {
   pointCount: 0, bytesReceived: 0, bytesExpected: 0, level: 0, error: null, firstRenderMs: null,
   // Names of the model's vertex attributes ('color' draws as vertex colours).
   attributes: [],
+  // A stream with simplex labels: its labels, ascending (header.labels:
+  // the label of each materialIndex), and whether the surface is coloured
+  // by them.
+  labelled: false, labels: [], colouredByLabel: false,
   // A glTF scene: its compressed primitives (streams) and those complete.
   streams: 0, streamsComplete: 0,
   // The complete model's totals, from the stream's header.
@@ -184,6 +188,41 @@ function fitFog() {
   scene.fog.far = distance + 3 * modelRadius;
 }
 
+// Colouring by label: the surface Mesh draws each label group with a
+// material of a fixed palette, chosen by the group's materialIndex (the
+// label's index in the stream's label table, the same at every level), so
+// that a region keeps its colour from level to level. One material per
+// palette colour, made on first use.
+const labelPalette = [0x4e79a7, 0xf28e2b, 0xe15759, 0x76b7b2, 0x59a14f, 0xedc948, 0xb07aa1, 0xff9da7, 0x9c755f, 0xbab0ac];
+const labelMaterials = [];  // palette index -> material
+function labelMaterial(materialIndex) {
+  const colour = materialIndex % labelPalette.length;
+  if (!labelMaterials[colour]) {
+    labelMaterials[colour] = loader.materials.surface.clone();
+    labelMaterials[colour].color.set(labelPalette[colour]);
+  }
+  return labelMaterials[colour];
+}
+
+// The surface of the current model coloured by label when the toggle is on
+// and the level has label groups, else with the material the loader gave it
+// (kept aside while the palette is on).
+function colourByLabel() {
+  const surface = current?.children?.[0];
+  if (!surface?.isMesh) return;
+  const labels = surface.geometry.userData.labels;
+  const on = $('labels').checked && Boolean(labels?.length);
+  if (on) {
+    if (!Array.isArray(surface.material)) surface.userData.ownMaterial = surface.material;
+    surface.material = Array.from(labels, (label, materialIndex) => labelMaterial(materialIndex));
+  } else if (surface.userData.ownMaterial) {
+    surface.material = surface.userData.ownMaterial;
+    delete surface.userData.ownMaterial;
+  }
+  viewer.colouredByLabel = on;
+  requestRender();
+}
+
 function frame(group) {
   const box = new THREE.Box3().setFromObject(group);
   if (box.isEmpty()) return;
@@ -221,6 +260,11 @@ function paintStatus() {
   pendingStatus = pendingProgress = null;
 }
 
+// An attribute's name, with its coding when the stream quantized it.
+function describeAttribute(name, { coding, codingBits }) {
+  return coding === 'exact' ? name : `${name} (${coding} ${codingBits} bits)`;
+}
+
 function describe(stats) {
   const m = stats.model;
   const count = (n) => n.toLocaleString('en-US');
@@ -235,7 +279,8 @@ function describe(stats) {
     (viewer.triangleCount ? ` · ${count(viewer.triangleCount)} triangles` : '') +
     (viewer.tetrahedronCount ? ` · ${count(viewer.tetrahedronCount)} tetrahedra` : '') +
     (viewer.edgeCount ? ` · ${count(viewer.edgeCount)} edges` : '') +
-    (viewer.attributes.length ? ` · ${viewer.attributes.join(', ')}` : '') +
+    (viewer.attributes.length ? ` · ${viewer.attributes.map((name) => describeAttribute(name, m.attributes[name])).join(', ')}` : '') +
+    (viewer.labelled ? ` · ${count(viewer.labels.length)} labels` : '') +
     ` · ${bpv} bits/vertex${m?.complete ? '' : ' so far'}`;
 }
 
@@ -253,7 +298,9 @@ function start(load) {
   Object.assign(viewer, {
     state: 'loading', refinements: 0, error: null, firstRenderMs: null, completeMs: null, finalRenderMs: null, bytesReceived: 0,
     bytesExpected: 0, levelCount: 0, vertexTotal: 0, levelsSeen: [], longTasks: [], attributes: [], streams: 0, streamsComplete: 0,
+    labelled: false, labels: [], colouredByLabel: false,
   });
+  $('labels-option').hidden = true;
   pendingStatus = pendingProgress = null;
   $('progress').value = $('decoded').value = 0;
   showStatus('loading…');
@@ -269,7 +316,10 @@ function start(load) {
     onAnimate: requestRender,
     onHeader(header) {
       if (!isCurrent()) return;
-      Object.assign(viewer, { levelCount: header.depth, vertexTotal: header.vertexCount });
+      Object.assign(viewer, {
+        levelCount: header.depth, vertexTotal: header.vertexCount, labelled: header.labelled, labels: Array.from(header.labels ?? []),
+      });
+      $('labels-option').hidden = !header.labelled;  // offered only for models with labels
     },
     onProgress(stats) {
       if (!isCurrent()) return;
@@ -285,6 +335,7 @@ function start(load) {
         tetrahedronCount: m.tetrahedra.length / 4, edgeCount: m.edges.length / 2, pointCount: m.points.length,
         level: m.progress.level, attributes: Object.keys(m.attributes),
       });
+      colourByLabel();
       if (!viewer.levelsSeen.includes(m.progress.level)) viewer.levelsSeen.push(m.progress.level);
       if (!framed) { frame(model); framed = true; }
       if (m.complete) {
@@ -462,6 +513,7 @@ $('throttle').addEventListener('change', () => reloadCurrent?.());
 $('stop').addEventListener('click', () => controller?.abort());
 $('geomorph').addEventListener('change', () => reloadCurrent?.());
 $('wireframe').addEventListener('change', () => reloadCurrent?.());
+$('labels').addEventListener('change', colourByLabel);
 
 $('file').addEventListener('change', () => $('file').files[0] && openFile($('file').files[0]));
 const view = $('view');

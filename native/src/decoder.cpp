@@ -712,6 +712,7 @@ bool Decoder::complete() const { return state_->complete(); }
 const std::vector<ChunkInfo>& Decoder::chunks() const { return state_->chunks; }
 CodingCost Decoder::cost() const { return state_->cost; }
 const std::vector<uint32_t>& Decoder::vertexParents() const { return state_->parents; }
+const std::vector<int32_t>& Decoder::labels() const { return state_->labelTable; }
 ConnectivityStatistics Decoder::statistics() const {
   if (!state_->splitter) return {};
   ConnectivityStatistics statistics = state_->splitter->statistics();

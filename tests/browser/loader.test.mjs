@@ -382,19 +382,32 @@ test('vertex attributes: color, the stream\'s normals, uv and others on the geom
   await page.close();
 });
 
+// A 40 × 1 sheet of 40 × 10 quads facing the camera (z a little wavy),
+// two triangles each, labelled 5 on the left half and -2 on the right;
+// coded exactly in small chunks, for many levels. `labelled.kdm`, decoded
+// in Node.
+let labelled;
+async function labelledStrip() {
+  if (labelled) return labelled;
+  const columns = 40, rows = 10, vertices = [], faces = [];
+  for (let j = 0; j <= rows; ++j)
+    for (let i = 0; i <= columns; ++i) vertices.push(`${i} ${j / rows} ${(0.05 * Math.sin(3 * i + 7 * j)).toFixed(6)}`);
+  for (let j = 0; j < rows; ++j)
+    for (let i = 0; i < columns; ++i) {
+      const label = i < columns / 2 ? 5 : -2;
+      const a = j * (columns + 1) + i, b = a + 1, c = a + columns + 2, d = a + columns + 1;
+      faces.push(`3 ${a} ${b} ${c} ${label}`, `3 ${a} ${c} ${d} ${label}`);
+    }
+  const header = ['ply', 'format ascii 1.0', `element vertex ${vertices.length}`, 'property float x', 'property float y',
+    'property float z', `element face ${faces.length}`, 'property list uchar int vertex_indices', 'property int label', 'end_header'];
+  writeFileSync(join(models, 'labelled.ply'), [...header, ...vertices, ...faces].join('\n') + '\n');
+  execFileSync(cli, ['encode', join(models, 'labelled.ply'), '-o', join(models, 'labelled.kdm'), '--exact', '--chunk-bytes', '256', '-q']);
+  labelled = await decode(readFileSync(join(models, 'labelled.kdm')));
+  return labelled;
+}
+
 test('simplex labels reach stats.model as the decoder gives them', async () => {
-  // A strip of quads, two triangles each, labelled 5 on the left half and -2 on the right.
-  const columns = 40, lines = [];
-  for (let i = 0; i <= columns; ++i) lines.push(`${i} 0 0`, `${i} 1 0.25`);
-  for (let i = 0; i < columns; ++i) {
-    const label = i < columns / 2 ? 5 : -2;
-    lines.push(`3 ${2 * i} ${2 * i + 2} ${2 * i + 3} ${label}`, `3 ${2 * i} ${2 * i + 3} ${2 * i + 1} ${label}`);
-  }
-  const header = ['ply', 'format ascii 1.0', `element vertex ${2 * (columns + 1)}`, 'property float x', 'property float y',
-    'property float z', `element face ${2 * columns}`, 'property list uchar int vertex_indices', 'property int label', 'end_header'];
-  writeFileSync(join(models, 'labelled.ply'), [...header, ...lines].join('\n') + '\n');
-  execFileSync(cli, ['encode', join(models, 'labelled.ply'), '-o', join(models, 'labelled.kdm'), '--bits', '12', '-q']);
-  const decoded = await decode(readFileSync(join(models, 'labelled.kdm')));
+  const decoded = await labelledStrip();
   const { page, errors } = await openPage();
   const result = await page.evaluate(async () => {
     const loader = new KDMeshLoader();
@@ -404,6 +417,95 @@ test('simplex labels reach stats.model as the decoder gives them', async () => {
     return { triangles: Array.from(labels.triangles), count: triangles.length / 3 };
   });
   assert.deepEqual(result, { triangles: Array.from(decoded.labels.triangles), count: decoded.triangles.length / 3 });
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('labels become geometry groups: a material array draws each label with its own material', async () => {
+  const decoded = await labelledStrip();
+  const { page, errors } = await openPage();
+  const result = await page.evaluate(async () => {
+    const renderer = new THREE.WebGLRenderer({ preserveDrawingBuffer: true });
+    renderer.setSize(160, 64, false);
+    const camera = new THREE.OrthographicCamera(-0.5, 40.5, 1.1, -0.1, -10, 10);
+    // Red for the lower label (-2, the right half), green for the higher (5, the left).
+    const materials = [0xff0000, 0x00ff00].map((color) => new THREE.MeshBasicMaterial({ color, side: THREE.DoubleSide }));
+    // Pixels of a frame whose red or green is the larger, in the left and the right half of the canvas.
+    const halves = (scene) => {
+      renderer.render(scene, camera);
+      const gl = renderer.getContext();
+      const pixels = new Uint8Array(160 * 64 * 4);
+      gl.readPixels(0, 0, 160, 64, gl.RGBA, gl.UNSIGNED_BYTE, pixels);
+      const out = { left: { red: 0, green: 0 }, right: { red: 0, green: 0 } };
+      for (let i = 0; i < pixels.length; i += 4) {
+        const half = (i / 4) % 160 < 80 ? out.left : out.right;
+        if (pixels[i] > 200 && pixels[i + 1] < 50) half.red += 1;
+        if (pixels[i + 1] > 200 && pixels[i] < 50) half.green += 1;
+      }
+      return out;
+    };
+    const loader = new KDMeshLoader();
+    const levels = [];
+    const group = loader.loadProgressive('models/labelled.kdm?throttle=40', {
+      materials,
+      onRefine(model, stats) {
+        const { geometry } = model.children[0];
+        levels.push({
+          groups: geometry.groups.map(({ start, count, materialIndex }) => ({ start, count, materialIndex })),
+          expected: stats.model.groups.map(({ start, count, materialIndex }) => ({ start, count, materialIndex })),
+          labels: Array.from(geometry.userData.labels), header: Array.from(stats.header.labels),
+          modelLabels: stats.model.groups.map((g) => g.label),
+          drawCount: geometry.drawRange.count, surface: stats.model.surface.length,
+        });
+      },
+    });
+    await group.userData.loaded;
+    const arrayScene = new THREE.Scene().add(group);
+    const drawn = halves(arrayScene);
+    const mesh = group.children[0];
+    const material = mesh.material;
+    // The same geometry with one material draws whole, groups or not.
+    mesh.material = materials[0];
+    const single = halves(arrayScene);
+    mesh.material = material;
+    // loadGeometry: the groups on the one geometry, for the page's own Mesh.
+    const geometry = loader.loadGeometry('models/labelled.kdm');
+    await geometry.userData.loaded;
+    const own = halves(new THREE.Scene().add(new THREE.Mesh(geometry, materials)));
+    // A model without labels: no groups, and one material as before.
+    const plain = await loader.loadAsync('models/fandisk.kdm');
+    loader.dispose();
+    renderer.dispose();
+    return {
+      levels, drawn, single, own, sameMaterial: material === materials,
+      geometryGroups: geometry.groups.length, geometryLabels: Array.from(geometry.userData.labels),
+      plain: { groups: plain.children[0].geometry.groups.length, labels: plain.children[0].geometry.userData.labels ?? null },
+    };
+  });
+  assert.ok(result.levels.length >= 2, `levels: ${result.levels.length}`);
+  for (const level of result.levels) {
+    // Every level's groups are the worker's, and cover what is drawn.
+    assert.deepEqual(level.groups, level.expected, JSON.stringify(level));
+    // userData.labels is the header's table at every level, each group's label at its materialIndex.
+    assert.deepEqual(level.labels, [-2, 5], JSON.stringify(level));
+    assert.deepEqual(level.header, [-2, 5], JSON.stringify(level));
+    assert.deepEqual(level.groups.map((g) => level.labels[g.materialIndex]), level.modelLabels, JSON.stringify(level));
+    assert.equal(level.groups.reduce((sum, g) => sum + g.count, 0), level.drawCount, JSON.stringify(level));
+    assert.equal(level.drawCount, level.surface);
+  }
+  const last = result.levels.at(-1);
+  const counts = [-2, 5].map((label) => 3 * decoded.labels.triangles.filter((l) => l === label).length);
+  assert.deepEqual(last.groups, [{ start: 0, count: counts[0], materialIndex: 0 }, { start: counts[0], count: counts[1], materialIndex: 1 }]);
+  assert.equal(result.sameMaterial, true);
+  // Label 5 (materialIndex 1, green) on the left, -2 (materialIndex 0, red) on the right.
+  for (const drawn of [result.drawn, result.own]) {
+    assert.ok(drawn.left.green > 1000 && drawn.left.red === 0, JSON.stringify(drawn));
+    assert.ok(drawn.right.red > 1000 && drawn.right.green === 0, JSON.stringify(drawn));
+  }
+  assert.ok(result.single.left.red > 1000 && result.single.right.red > 1000 && result.single.left.green === 0, JSON.stringify(result.single));
+  assert.equal(result.geometryGroups, 2);
+  assert.deepEqual(result.geometryLabels, [-2, 5]);
+  assert.deepEqual(result.plain, { groups: 0, labels: null });
   assert.deepEqual(errors, []);
   await page.close();
 });

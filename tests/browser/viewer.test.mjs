@@ -10,7 +10,7 @@ import { launchChromium } from './chromium.mjs';
 import { decode } from 'kdmesh';
 import { startServer } from '../../web/server.mjs';
 import { modelChecksum } from '../../web/model-checksum.js';
-import { root, cli, colouredTorus, writePly } from '../js/fixtures.mjs';
+import { root, cli, colouredTorus, labelledTorus, writeLabelledPly, writePly } from '../js/fixtures.mjs';
 import { writeTestScene } from '../js/gltf-fixtures.mjs';
 
 const models = mkdtempSync(join(tmpdir(), 'kdmesh-browser-'));
@@ -31,6 +31,11 @@ before(async () => {
   // A torus with vertex colours, red on one side and blue on the other.
   writePly(join(models, 'coloured.ply'), colouredTorus());
   execFileSync(cli, ['encode', join(models, 'coloured.ply'), '-o', join(models, 'coloured.kdm'), '--bits', '12', '-q']);
+  execFileSync(cli, ['encode', join(models, 'coloured.ply'), '-o', join(models, 'quantized.kdm'), '--bits', '12', '--attr-bits', '12',
+    '--normal-bits', '10', '-q']);
+  // A torus whose triangles carry four labels, one per quarter.
+  writeLabelledPly(join(models, 'labelled.ply'), labelledTorus());
+  execFileSync(cli, ['encode', join(models, 'labelled.ply'), '-o', join(models, 'labelled.kdm'), '--bits', '12', '-q']);
   // A glTF scene whose torus, line loop and point cloud are kdmesh streams.
   writeTestScene(join(models, 'input-scene.glb'));
   execFileSync(cli, ['encode', join(models, 'input-scene.glb'), '-o', join(models, 'scene.kdm.glb'), '-q']);
@@ -209,12 +214,21 @@ test('an opened mesh file: encoding state, the menu shows it, toggles reload it;
 test('the header stays on one line at 1000 px, and the point cloud is shaded, not a flat silhouette', async () => {
   const { page, errors } = await openViewer('model=points', { width: 1000, height: 700 });
   await page.waitForFunction(() => window.kdmeshViewer.state === 'complete', null, { timeout: 60000 });
-  const tops = await page.$$eval('header > *', (children) => children.map((child) => Math.round(child.getBoundingClientRect().top)));
-  assert.ok(Math.max(...tops) - Math.min(...tops) <= 6, `tops of the header's items: ${tops}`);
+  // Tops of the header's items shown (the label option is hidden for models without labels).
+  const tops = () => page.$$eval('header > *', (children) => children.filter((child) => child.getClientRects().length)
+    .map((child) => Math.round(child.getBoundingClientRect().top)));
+  const points = await tops();
+  assert.ok(Math.max(...points) - Math.min(...points) <= 6, `tops of the header's items: ${points}`);
   assert.equal(await page.$eval('#file', (input) => input.accept.split(',').includes('.xyz')), true);
   const share = await page.evaluate(() => window.kdmeshViewer.commonestColourShare());
   await page.screenshot({ path: join(screenshots, 'points.png') });
   assert.ok(share > 0 && share < 0.2, `share of the commonest colour: ${share}`);
+  // With the label option shown too.
+  await page.selectOption('#model', 'labelled.kdm');
+  await page.waitForFunction(() => window.kdmeshViewer.state === 'complete' && window.kdmeshViewer.labelled, null, { timeout: 60000 });
+  const labelled = await tops();
+  assert.equal(labelled.length, points.length + 1);
+  assert.ok(Math.max(...labelled) - Math.min(...labelled) <= 6, `tops of the header's items: ${labelled}`);
   assert.deepEqual(errors, []);
   await page.close();
 });
@@ -249,6 +263,66 @@ test('a glTF scene from the gallery and from the file picker: its streams comple
   await page.setInputFiles('#file', { name: 'picked.kdm.glb', mimeType: 'model/gltf-binary', buffer: readFileSync(join(models, 'scene.kdm.glb')) });
   await page.waitForFunction(() => window.kdmeshViewer.source === 'picked.kdm.glb' && window.kdmeshViewer.state === 'complete', null, { timeout: 60000 });
   assert.equal((await viewerState(page)).streamsComplete, 3);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('a labelled model offers colouring by label, which draws the label groups in palette colours', async () => {
+  // Pixels of the canvas's last frame whose red exceeds their blue by more
+  // than 40: the default surface is grey-blue, the palette's second and
+  // third colours are orange and red.
+  const warmPixels = (page) => page.evaluate(async () => {
+    await new Promise((resolve) => requestAnimationFrame(() => requestAnimationFrame(resolve)));
+    const view = document.querySelector('#view canvas');
+    const canvas = document.createElement('canvas');
+    canvas.width = view.width;
+    canvas.height = view.height;
+    const context = canvas.getContext('2d');
+    context.drawImage(view, 0, 0);
+    const data = context.getImageData(0, 0, canvas.width, canvas.height).data;
+    let count = 0;
+    for (let i = 0; i < data.length; i += 4) if (data[i] > data[i + 2] + 40) ++count;
+    return count;
+  });
+  const { page, errors } = await openViewer('model=coloured.kdm');
+  await page.waitForFunction(() => window.kdmeshViewer.state === 'complete', null, { timeout: 60000 });
+  assert.equal(await page.isVisible('#labels'), false, 'no label option for a model without labels');
+  await page.selectOption('#model', 'labelled.kdm');
+  await page.waitForFunction(() => window.kdmeshViewer.state === 'complete' && window.kdmeshViewer.source.includes('labelled'), null,
+    { timeout: 60000 });
+  assert.equal(await page.isVisible('#labels'), true);
+  let state = await viewerState(page);
+  assert.deepEqual({ labelled: state.labelled, labels: state.labels, coloured: state.colouredByLabel },
+    { labelled: true, labels: [-1, 10, 20, 30], coloured: false });
+  // The status line is written at the next animation frame after the state.
+  await page.waitForFunction(() => / · 4 labels · .* bits\/vertex$/.test(document.getElementById('status').textContent), null,
+    { timeout: 10000 });
+  const plain = await warmPixels(page);
+  await page.click('#labels');
+  await page.waitForFunction(() => window.kdmeshViewer.colouredByLabel);
+  const coloured = await warmPixels(page);
+  await page.screenshot({ path: join(screenshots, 'labelled-torus.png') });
+  await page.click('#labels');
+  await page.waitForFunction(() => !window.kdmeshViewer.colouredByLabel);
+  const again = await warmPixels(page);
+  assert.ok(plain < 50 && again < 50, `warm pixels without label colours: ${plain}, ${again}`);
+  assert.ok(coloured > 2000, `warm pixels with label colours: ${coloured}`);
+  // Loading again with the toggle on colours every level as it arrives.
+  await page.click('#labels');
+  await page.selectOption('#throttle', '256');
+  await page.waitForFunction(() => window.kdmeshViewer.state === 'complete', null, { timeout: 60000 });
+  state = await viewerState(page);
+  assert.equal(state.colouredByLabel, true);
+  assert.ok(await warmPixels(page) > 2000);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('the status line says how quantized attributes are coded', async () => {
+  const { page, errors } = await openViewer('model=quantized.kdm');
+  await page.waitForFunction(() => window.kdmeshViewer.state === 'complete', null, { timeout: 60000 });
+  await page.waitForFunction(() => !document.getElementById('status').textContent.includes('so far'), null, { timeout: 10000 });
+  assert.match(await page.textContent('#status'), / · color, normal \(octahedral 10 bits\), uv \(uniform 12 bits\), label · /);
   assert.deepEqual(errors, []);
   await page.close();
 });

@@ -131,3 +131,35 @@ test('in pieces: every prefix snapshot has whole attributes of input values, cut
     assertSameAttributes(whole.attributes, nativeAttributes(nativeDecode(kdm), shape), `${what} whole`);
   }
 });
+
+test('each attribute says how the stream codes it, as kdmesh info does, at every prefix', async () => {
+  const codings = (attributes) => Object.entries(attributes).map(([name, { coding, codingBits }]) => [name, coding, codingBits]);
+  const cases = [
+    [shapes.torus, ['--attr-bits', '12', '--normal-bits', '10'],
+      [['color', 'exact', 0], ['normal', 'octahedral', 10], ['uv', 'uniform', 12], ['label', 'exact', 0]]],
+    [shapes.torus, ['--attr-bits', '7'],  // without --normal-bits, normals are quantized like any float32
+      [['color', 'exact', 0], ['normal', 'uniform', 7], ['uv', 'uniform', 7], ['label', 'exact', 0]]],
+    [shapes.torus, ['--normal-bits', '8'],
+      [['color', 'exact', 0], ['normal', 'octahedral', 8], ['uv', 'exact', 0], ['label', 'exact', 0]]],
+    [shapes.cloud, ['--normal-bits', '8'], [['color', 'exact', 0], ['intensity', 'exact', 0]]],
+    [shapes.cloud, ['--attr-bits', '9'], [['color', 'exact', 0], ['intensity', 'uniform', 9]]],
+  ];
+  for (const [shape, options, expected] of cases) {
+    const ply = join(workDir, 'coding.ply');
+    writePly(ply, shape);
+    const kdm = join(workDir, 'coding.kdm');
+    execFileSync(cli, ['encode', ply, '-o', kdm, '--bits', '12', '--chunk-bytes', '256', '-q', ...options]);
+    const what = `${shape === shapes.torus ? 'torus' : 'cloud'} ${options.join(' ')}`;
+    const info = JSON.parse(execFileSync(cli, ['info', kdm, '--json'], { encoding: 'utf8' }));
+    assert.deepEqual(info.attributes.map(({ name, coding, codingBits }) => [name, coding, codingBits]), expected, `${what}: info`);
+    const bytes = readFileSync(kdm);
+    assert.deepEqual(codings((await decode(bytes)).attributes), expected, `${what}: decode()`);
+    const decoder = await createDecoder();
+    for (let at = 0; at < bytes.length; at += 300) {
+      decoder.push(bytes.subarray(at, at + 300));
+      const { attributes } = decoder.snapshot({ copy: false });
+      if (Object.keys(attributes).length) assert.deepEqual(codings(attributes), expected, `${what} at ${at} bytes`);
+    }
+    decoder.dispose();
+  }
+});

@@ -83,6 +83,40 @@ export function colouredTorus(rows = 24, columns = 40) {
   };
 }
 
+// A torus of rows × columns quads, two triangles each, labelled by the
+// quarter of the ring they lie in (labels -1, 10, 20, 30).
+export function labelledTorus(rows = 20, columns = 36) {
+  const positions = [], triangles = [], labels = [];
+  for (let j = 0; j < rows; ++j)
+    for (let i = 0; i < columns; ++i) {
+      const a = (2 * Math.PI * i) / columns, b = (2 * Math.PI * j) / rows;
+      positions.push(Math.fround((3 + Math.cos(b)) * Math.cos(a)), Math.fround((3 + Math.cos(b)) * Math.sin(a)),
+        Math.fround(Math.sin(b)));
+    }
+  const id = (i, j) => (j % rows) * columns + (i % columns);
+  const regions = [-1, 10, 20, 30];
+  for (let j = 0; j < rows; ++j)
+    for (let i = 0; i < columns; ++i) {
+      triangles.push(id(i, j), id(i + 1, j), id(i + 1, j + 1), id(i, j), id(i + 1, j + 1), id(i, j + 1));
+      const region = regions[Math.floor((4 * i) / columns)];
+      labels.push(region, region);
+    }
+  return { positions, triangles, labels };
+}
+
+// The shape as an ascii PLY file (its triangles as faces, or its
+// tetrahedra as tetras), with its labels as a property of those or without.
+export function writeLabelledPly(path, { positions, triangles, tetrahedra, labels }, withLabels = true) {
+  const [element, corners, list] = triangles ? ['face', 3, triangles] : ['tetra', 4, tetrahedra];
+  const lines = ['ply', 'format ascii 1.0', `element vertex ${positions.length / 3}`, 'property float x',
+    'property float y', 'property float z', `element ${element} ${list.length / corners}`,
+    'property list uchar int vertex_indices', ...(withLabels ? ['property int label'] : []), 'end_header'];
+  for (let i = 0; i < positions.length; i += 3) lines.push(positions.slice(i, i + 3).join(' '));
+  for (let t = 0; t < labels.length; ++t)
+    lines.push(`${corners} ${list.slice(corners * t, corners * t + corners).join(' ')}${withLabels ? ` ${labels[t]}` : ''}`);
+  writeFileSync(path, lines.join('\n') + '\n');
+}
+
 // A point cloud with RGBA colours and a float 'intensity'; every tenth point
 // repeats the previous one's position with other values.
 export function colouredCloud(count = 2000, seed = 5) {

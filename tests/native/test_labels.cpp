@@ -253,6 +253,51 @@ TEST(Labels, StreamsWithoutLabelsAreUnchanged) {
   EXPECT_TRUE(decoder.snapshot().labels.empty());
 }
 
+// Decoder::labels() on every byte prefix: empty until the label table's
+// last byte (after the header; the sphere has no attribute table), then
+// the input's distinct labels, ascending, holding every label a snapshot
+// shows; empty again after reset().
+TEST(Labels, DecoderGivesTheTableOnceRead) {
+  Complex c = sphereMesh(16, 20);
+  std::mt19937 rng(7);
+  for (size_t i = 0; i < c.simplexCount(2); ++i) c.labels.triangles.push_back(int32_t(rng() % 9) * 1000 - 4000);
+  std::vector<int32_t> distinct = c.labels.triangles;
+  std::sort(distinct.begin(), distinct.end());
+  distinct.erase(std::unique(distinct.begin(), distinct.end()), distinct.end());
+  ASSERT_GT(distinct.size(), 5u);
+  const EncodeResult encoded = encode(c, exactOptions());
+  ASSERT_TRUE(encoded.status.ok());
+  size_t headerBytes = 0;
+  ASSERT_TRUE(headerSize(encoded.bytes.data(), headerBytes).ok());
+  std::vector<uint8_t> table;
+  writeLabelTable(distinct, table);
+  const size_t tableEnd = headerBytes + table.size();
+  Decoder decoder;
+  for (size_t at = 0; at < encoded.bytes.size(); ++at) {
+    if (at < tableEnd) {
+      EXPECT_TRUE(decoder.labels().empty()) << "prefix of " << at << " bytes";
+    } else {
+      ASSERT_EQ(decoder.labels(), distinct) << "prefix of " << at << " bytes";
+      for (const int32_t label : decoder.snapshot().labels.triangles)
+        EXPECT_TRUE(std::binary_search(distinct.begin(), distinct.end(), label)) << label;
+    }
+    ASSERT_TRUE(decoder.push(&encoded.bytes[at], 1).ok());
+  }
+  ASSERT_TRUE(decoder.complete());
+  EXPECT_EQ(decoder.labels(), distinct);
+  decoder.reset();
+  EXPECT_TRUE(decoder.labels().empty());
+}
+
+TEST(Labels, DecoderGivesNoTableWithoutLabels) {
+  const EncodeResult encoded = encode(torusMesh(12, 16), exactOptions());
+  ASSERT_TRUE(encoded.status.ok());
+  Decoder decoder;
+  ASSERT_TRUE(decoder.push(encoded.bytes.data(), encoded.bytes.size()).ok());
+  ASSERT_TRUE(decoder.complete());
+  EXPECT_TRUE(decoder.labels().empty());
+}
+
 TEST(Labels, EncoderRefusesMismatchedCounts) {
   Complex c = sphereMesh(6, 8);
   c.labels.triangles.assign(c.simplexCount(2) - 1, 1);

@@ -29,11 +29,13 @@ test('wrong uses of the declarations are type errors', (t) => {
     'export const count: string = (await decode(new Uint8Array(1))).vertexCount;',
     "new KDMeshLoader().setWorkerLimit('4');",
     "new KDMeshLoader().loadProgressive('a.kdm', { tetrahedra: 'solid' });",
+    "export const coding: 'lossy' = (await decode(new Uint8Array(1))).attributes.normal.coding;",
+    "new KDMeshLoader().loadProgressive('a.kdm', { materials: ['red'] });",
   ].join('\n'));
   writeFileSync(join(dir, 'tsconfig.json'), JSON.stringify({ extends: join(here, 'tsconfig.json'), files: ['wrong.ts'] }));
   const result = tsc(dir);
   assert.notEqual(result.status, 0);
-  for (const line of [3, 4, 5]) assert.match(result.stdout, new RegExp(`wrong\\.ts\\(${line},`), result.stdout);
+  for (const line of [3, 4, 5, 6, 7]) assert.match(result.stdout, new RegExp(`wrong\\.ts\\(${line},`), result.stdout);
 });
 
 test('every runtime export is declared', () => {

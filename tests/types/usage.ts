@@ -1,10 +1,13 @@
 // Uses every export of kdmesh, kdmesh/three and kdmesh/gltf as a TypeScript program
 // would; tests/types/types.test.mjs compiles it with tsc --strict.
 import {
-  compileWasm, createDecoder, decode, Decoder, Header, KdmeshError, memoryInUse, Model, Progress, setWasmSource, VertexAttribute,
+  AttributeCoding, compileWasm, createDecoder, decode, Decoder, Header, KdmeshError, memoryInUse, Model, Progress, setWasmSource,
+  VertexAttribute,
 } from 'kdmesh';
-import { GpuFence, KDMeshLoader, LoadStats, StreamedModel } from 'kdmesh/three';
-import { BufferGeometry, Group, LoadingManager, Mesh, MeshNormalMaterial, PerspectiveCamera, Scene, WebGLRenderer } from 'three';
+import { GpuFence, KDMeshLoader, LabelGroup, LoadStats, StreamedModel } from 'kdmesh/three';
+import {
+  BufferGeometry, Group, LoadingManager, Mesh, MeshBasicMaterial, MeshNormalMaterial, PerspectiveCamera, Scene, WebGLRenderer,
+} from 'three';
 
 export async function decoding(bytes: Uint8Array): Promise<number> {
   setWasmSource(new URL('https://example.com/kdmesh-wasm.wasm'));
@@ -17,8 +20,11 @@ export async function decoding(bytes: Uint8Array): Promise<number> {
   const coarse = decoder.snapshot({ copy: false });
   const parents: Uint32Array = decoder.parents();
   const colour: VertexAttribute | undefined = coarse.attributes.color;
-  const attributeValues = (colour?.array.length ?? 0) + (colour?.itemSize ?? 0) + (header?.attributeCount ?? 0);
+  const coding: AttributeCoding | undefined = coarse.attributes.normal?.coding;
+  const quantized = coding === 'uniform' || coding === 'octahedral' ? coarse.attributes.normal.codingBits : 0;
+  const attributeValues = (colour?.array.length ?? 0) + (colour?.itemSize ?? 0) + (header?.attributeCount ?? 0) + quantized;
   const regions: Int32Array | undefined = header?.labelled ? coarse.labels?.triangles : undefined;
+  const table: Int32Array | null = header?.labels ?? null;
   decoder.finish();
   decoder.dispose();
   try {
@@ -27,7 +33,8 @@ export async function decoding(bytes: Uint8Array): Promise<number> {
     if (error instanceof KdmeshError) return error.code.length;
   }
   return model.positions.length + progress.errorBound + (header?.simplexCounts[2] ?? 0) + coarse.triangles.length +
-    parents.length + attributeValues + (regions?.length ?? 0) + (await memoryInUse()) + (model.stats.bitsPerVertex > 0 ? 1 : 0);
+    parents.length + attributeValues + (regions?.length ?? 0) + (table?.length ?? 0) + (await memoryInUse()) +
+    (model.stats.bitsPerVertex > 0 ? 1 : 0);
 }
 
 export async function loading(renderer: WebGLRenderer): Promise<BufferGeometry> {
@@ -68,9 +75,20 @@ export async function loading(renderer: WebGLRenderer): Promise<BufferGeometry> 
   scene.add(new Mesh(geometry, new MeshNormalMaterial()));
   const primitive: 'triangles' | 'lines' | 'points' | undefined = geometry.userData.primitive;
   await geometry.userData.loaded;
+  // Simplex labels as groups: one material per label of the stream's table.
+  const byLabel = loader.loadProgressive('e.kdm', {
+    materials: [new MeshBasicMaterial({ color: 0xff0000 }), new MeshBasicMaterial({ color: 0x00ff00 })],
+    onRefine: (object: Group, stats: LoadStats) => {
+      const groups: LabelGroup[] = stats.model?.groups ?? [];
+      return groups.every((g) =>
+        stats.header?.labels?.[g.materialIndex] === g.label && g.start + g.count <= (stats.model?.surface.length ?? 0));
+    },
+  });
+  const labels: Int32Array | undefined = geometry.userData.labels;
+  scene.add(byLabel);
   const fence = new GpuFence(renderer.getContext() as WebGL2RenderingContext);
   fence.set();
-  const busy: number = loader.busyWorkers + (fence.passed() ? 1 : 0) + (primitive ? 1 : 0) + whole.children.length;
+  const busy: number = loader.busyWorkers + (fence.passed() ? 1 : 0) + (primitive ? 1 : 0) + whole.children.length + (labels?.length ?? 0);
   loader.materials.surface.color.set(busy);
   return loader.abort().dispose() === loader ? geometry : new BufferGeometry();
 }

@@ -406,6 +406,13 @@ class Decoder {
   // from (0 for vertex 0), so a viewer can animate refinement and any final
   // vertex can be traced to its ancestor at a coarser level.
   const std::vector<uint32_t>& vertexParents() const;
+  // The stream's label table: its distinct simplex labels, ascending (the
+  // format stores them so). Snapshot labels are values of this table, and a
+  // label's index in it does not change from level to level, so a viewer
+  // can key a material by it before the label's first simplex arrives.
+  // Empty until the table has arrived (right after the header and the
+  // attribute table) and for streams without labels.
+  const std::vector<int32_t>& labels() const;
 
   // The model at the current level: one vertex in every current kd-tree
   // cell (clamped to the bounding box), placed as DecoderOptions::
