@@ -82,10 +82,11 @@ Status validate(const Header& h, const DecoderLimits& limits) {
   } else if (h.quantization == Quantization::Float32) {
     if (h.bits != 32) return corrupt("float32 mode must have 32 bits");
     for (int a = 0; a < 3; ++a) {
-      // Both ends of the coded range must be images of finite floats.
+      // Every 32-bit image is a float (infinities and NaNs included); the
+      // coded range must not run past the last one.
       const uint64_t low = h.floatImageMin[size_t(a)];
       const uint64_t high = low + h.gridMax[size_t(a)];
-      if (low < 0x00800000u || high > 0xff7fffffu) return corrupt("float range is not finite");
+      if (high > 0xffffffffu) return corrupt("float range runs past the largest float image");
     }
   } else {
     return corrupt("unknown quantization mode");

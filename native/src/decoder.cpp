@@ -507,8 +507,13 @@ struct Decoder::State {
         const double along = squared > 0 ? (m[0] * offset[0] + m[1] * offset[1] + m[2] * offset[2]) / squared : 0;
         for (size_t a = 0; a < 3; ++a) target[a] += squared > 0 ? along * m[a] : offset[a];
       }
+      // A float32 stream's infinite or NaN neighbours make no target: the
+      // vertex stays at its cell's centre. A cell bound that is not finite
+      // compares false, which leaves that side open, as the cell is.
       for (size_t a = 0; a < 3; ++a)
-        positions[i + a] = float(std::clamp(target[a], double(low[i + a]), double(high[i + a])));
+        positions[i + a] = std::isfinite(target[a])
+                               ? float(std::clamp(target[a], double(low[i + a]), double(high[i + a])))
+                               : centre[i + a];
     }
   }
 
@@ -755,7 +760,8 @@ double Decoder::errorBound() const {
       const double half =
           (double(s.dequantizer->position(a, hi, hi)) - double(s.dequantizer->position(a, lo, lo))) * share +
           halfStep;
-      squared += half * half;
+      // A float32 cell that holds NaNs has no bound.
+      squared += std::isnan(half) ? INFINITY : half * half;
     }
     worst = std::max(worst, squared);
   });

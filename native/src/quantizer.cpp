@@ -30,6 +30,11 @@ float fromOrderedImage(uint32_t image) {
   return bitsToFloat((image & 0x80000000u) ? (image ^ 0x80000000u) : ~image);
 }
 
+// Images of -FLT_MAX and FLT_MAX: below the first lie -infinity and the
+// negative NaNs, above the second +infinity and the positive NaNs.
+constexpr uint32_t kLowestFiniteImage = 0x00800000u;
+constexpr uint32_t kHighestFiniteImage = 0xff7fffffu;
+
 Status checkFinite(const std::vector<float>& positions) {
   for (size_t i = 0; i < positions.size(); ++i) {
     if (!std::isfinite(positions[i])) {
@@ -37,7 +42,7 @@ Status checkFinite(const std::vector<float>& positions) {
       return Status::error(ErrorCode::InvalidInput,
                            "vertex " + std::to_string(i / 3) + " has " +
                                (std::isnan(positions[i]) ? "a NaN" : "an infinite") + " " +
-                               kAxis[i % 3] + " coordinate");
+                               kAxis[i % 3] + " coordinate; exact mode (--exact) keeps it");
     }
   }
   return Status::success();
@@ -99,11 +104,14 @@ void quantizeGrid(const std::vector<float>& positions, int bits, Header& header,
 
 Status quantize(const std::vector<float>& positions, const EncodeOptions& options,
                 Header& header, std::vector<uint32_t>& coords) {
-  if (Status s = checkFinite(positions); !s.ok()) return s;
-  if (options.exact)
+  // Float32 mode codes bit patterns, so infinities and NaNs (with their
+  // sign and payload) are values like any other; a grid has no place for them.
+  if (options.exact) {
     quantizeFloat32(positions, header, coords);
-  else
-    quantizeGrid(positions, options.bits, header, coords);
+    return Status::success();
+  }
+  if (Status s = checkFinite(positions); !s.ok()) return s;
+  quantizeGrid(positions, options.bits, header, coords);
   return Status::success();
 }
 
@@ -113,9 +121,15 @@ float Dequantizer::position(int axis, uint32_t lo, uint32_t hi) const {
   const size_t a = size_t(axis);
   if (header_.quantization == Quantization::Float32) {
     const uint32_t base = header_.floatImageMin[a];
-    const float low = fromOrderedImage(base + lo);
-    if (lo == hi) return low;
-    return float((double(low) + double(fromOrderedImage(base + hi))) * 0.5);
+    uint32_t low = base + lo, high = base + hi;
+    if (low == high) return fromOrderedImage(low);
+    // A range that reaches infinities or NaNs stands for its finite part,
+    // so that a coarse vertex gets a number; a range beyond the finite
+    // floats stands for its end nearest to them (an infinity if it holds one).
+    low = std::max(low, kLowestFiniteImage);
+    high = std::min(high, kHighestFiniteImage);
+    if (low > high) return fromOrderedImage(low > kHighestFiniteImage ? low : high);
+    return float((double(fromOrderedImage(low)) + double(fromOrderedImage(high))) * 0.5);
   }
   const double centre = (double(lo) + double(hi)) * 0.5;
   return float(header_.origin[a] + centre * header_.step);

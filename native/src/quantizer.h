@@ -16,7 +16,8 @@ namespace kdmesh {
 
 // Fills the quantization fields of `header` (quantization, bits, gridMax,
 // origin, step, floatImageMin) and writes 3 integer coordinates per vertex.
-// Fails on NaN or infinite coordinates, naming the first such vertex.
+// Float32 mode keeps NaN and infinite coordinates (every bit pattern has an
+// image); grid mode fails on them, naming the first such vertex.
 Status quantize(const std::vector<float>& positions, const EncodeOptions& options,
                 Header& header, std::vector<uint32_t>& coords);
 
@@ -24,7 +25,8 @@ class Dequantizer {
  public:
   explicit Dequantizer(const Header& header);
   // Position of the integer coordinate range [lo, hi] along `axis`: the
-  // coordinate itself when lo == hi, the centre of the range otherwise.
+  // coordinate itself when lo == hi, the centre of the range otherwise
+  // (in float32 mode, of the range's finite floats: see position()).
   float position(int axis, uint32_t lo, uint32_t hi) const;
 
  private:

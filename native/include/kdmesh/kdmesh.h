@@ -119,7 +119,7 @@ struct Complex {
 enum class ErrorCode : uint8_t {
   Ok = 0,
   InvalidArgument,     // an option is out of range
-  InvalidInput,        // the complex cannot be encoded (NaN, bad index, ...)
+  InvalidInput,        // the complex cannot be encoded (NaN on a grid, bad index, ...)
   Unsupported,         // valid input that this version cannot encode
   BadMagic,            // the bytes are not a kdmesh stream
   UnsupportedVersion,  // a kdmesh stream from a newer format version
@@ -206,7 +206,9 @@ struct EncodeOptions {
   // error below 1/131070 of the largest extent: finer than float32 rendering
   // of a typical scan, and half the size of raw float32 coordinates.
   int bits = 16;
-  // Preserve every float32 coordinate bit for bit (overrides `bits`).
+  // Preserve every float32 coordinate bit for bit (overrides `bits`),
+  // infinities and NaNs (with their payloads) included; grid mode refuses
+  // them.
   bool exact = false;
   // Float32 vertex attributes are exact unless these are set (lossy):
   // `attributeBits` (1..24) quantizes each component of every float32
