@@ -71,7 +71,9 @@ struct ReadOptions {
 //   The .node point attributes become the attribute `attribute` (float32,
 //   up to 4 components; more are grouped by 4 as `attribute_0`,
 //   `attribute_4`, ...) and the boundary markers `marker`, of the narrowest
-//   integer type that holds them; the writer writes both back. Region
+//   integer type that holds them; the writer writes every column and the
+//   markers back (attributes named otherwise than the reader names them are
+//   refused rather than renamed). Region
 //   attributes of the .ele are counted in a note.
 //   readMemory can read one buffer only, so it reads a .node alone.
 // - VTK: legacy ascii UNSTRUCTURED_GRID or POLYDATA, cells in the classic
@@ -111,7 +113,7 @@ Status readFile(const std::string& path, Complex& out, Notes& notes,
 // OBJ `uv` (float32 × 2 or 3, as vt) and `normal` (float32 × 3, as vn); VTK
 // any whose name has no space; Medit `ref` and TetGen `marker` (integers, 1
 // component; read back as the narrowest type that holds their values) and
-// TetGen `attribute` (float32). (Text keeps a NaN's sign, not its payload.)
+// TetGen `attribute` or `attribute_0`, `attribute_4`, ... (float32). (Text keeps a NaN's sign, not its payload.)
 // Writers refuse a complex with an attribute their format cannot hold
 // (InvalidArgument) rather than drop it.
 bool holdsAttribute(Format format, const VertexAttribute& attribute);
