@@ -3,7 +3,8 @@
 # by encoding the reader seeds (tests/fuzz/seeds/) with build/kdmesh, one
 # stream per coding path: connectivity of every dimension on a grid and in
 # float32 mode, exact attributes, quantized and octahedral attributes with
-# labels, a label table, and infinite and NaN coordinates. Run it after a
+# labels, a label table, infinite and NaN coordinates, and float64
+# coordinates with their residual attributes. Run it after a
 # format change; the test FuzzSeeds.DecoderSeedsDecodeAndCoverEveryTable
 # fails until the streams are current.
 #
@@ -20,3 +21,4 @@ mkdir -p "$out"
 "$cli" encode "$in/regions.mesh" -o "$out/labels.kdm" --exact -q
 "$cli" encode "$in/surface.ply" -o "$out/quantized.kdm" --bits 10 --attr-bits 12 --normal-bits 8 -q
 "$cli" encode "$in/nonfinite.xyz" -o "$out/nonfinite.kdm" --exact -q
+"$cli" encode "$in/doubles.ply" -o "$out/float64.kdm" --exact -q

@@ -115,6 +115,63 @@ Status quantize(const std::vector<float>& positions, const EncodeOptions& option
   return Status::success();
 }
 
+namespace {
+
+// The bits of double(f), made by hand for NaNs: a conversion may change a
+// NaN's payload (WebAssembly leaves it unspecified), and the decoder must
+// widen exactly as the encoder did.
+uint64_t widenedBits(float f) {
+  const uint64_t u = floatBits(f);
+  if (std::isnan(f)) return (u >> 31) << 63 | uint64_t(0x7ff) << 52 | (u & 0x7fffffu) << 29;
+  const double d = f;
+  uint64_t bits;
+  std::memcpy(&bits, &d, 8);
+  return bits;
+}
+
+}  // namespace
+
+void splitFloat64(const std::vector<double>& positions64, std::vector<float>& positions,
+                  VertexAttribute& low, VertexAttribute& high) {
+  const size_t n = positions64.size();
+  positions.resize(n);
+  low = {kResidualNames[0], AttributeType::Int32, 3, std::vector<uint8_t>(n * 4), {}};
+  high = {kResidualNames[1], AttributeType::Int32, 3, std::vector<uint8_t>(n * 4), {}};
+  for (size_t i = 0; i < n; ++i) {
+    const double x = positions64[i];
+    positions[i] = float(x);
+    uint64_t bits;
+    std::memcpy(&bits, &x, 8);
+    const uint64_t residual = bits - widenedBits(positions[i]);
+    // The low part as a signed 32-bit value, so that small negative
+    // residuals leave the high part 0.
+    const uint32_t lowPart = uint32_t(residual);
+    const uint32_t highPart = uint32_t((residual - uint64_t(int64_t(int32_t(lowPart)))) >> 32);
+    std::memcpy(&low.values[i * 4], &lowPart, 4);
+    std::memcpy(&high.values[i * 4], &highPart, 4);
+  }
+}
+
+void joinFloat64(const std::vector<float>& positions, const VertexAttribute& low, const VertexAttribute& high,
+                 std::vector<double>& positions64) {
+  const size_t n = positions.size();
+  positions64.resize(n);
+  for (size_t i = 0; i < n; ++i) {
+    uint32_t lowPart, highPart;
+    std::memcpy(&lowPart, &low.values[i * 4], 4);
+    std::memcpy(&highPart, &high.values[i * 4], 4);
+    uint64_t bits = widenedBits(positions[i]);
+    bits += uint64_t(int64_t(int32_t(lowPart))) + (uint64_t(highPart) << 32);
+    std::memcpy(&positions64[i], &bits, 8);
+  }
+}
+
+bool areResidualAttributes(const VertexAttribute& low, const VertexAttribute& high) {
+  for (const VertexAttribute* a : {&low, &high})
+    if (a->type != AttributeType::Int32 || a->components != 3) return false;
+  return low.name == kResidualNames[0] && high.name == kResidualNames[1];
+}
+
 Dequantizer::Dequantizer(const Header& header) : header_(header) {}
 
 float Dequantizer::position(int axis, uint32_t lo, uint32_t hi) const {

@@ -134,9 +134,9 @@ TEST(FuzzSeeds, DecoderSeedsDecodeAndCoverEveryTable) {
   for (const auto& entry : std::filesystem::directory_iterator(std::filesystem::path(KDMESH_FUZZ_SEEDS) / "decoder"))
     if (entry.path().extension() == ".kdm") streams.push_back(entry.path());
   std::sort(streams.begin(), streams.end());
-  ASSERT_GE(streams.size(), 6u);
+  ASSERT_GE(streams.size(), 7u);
   bool grid = false, connectivity = false, exactAttribute = false, uniform = false, octahedral = false,
-       labelled = false, nonFinite = false;
+       labelled = false, nonFinite = false, float64 = false;
   for (const std::filesystem::path& path : streams) {
     SCOPED_TRACE(path.filename().string());
     std::vector<uint8_t> bytes;
@@ -149,6 +149,7 @@ TEST(FuzzSeeds, DecoderSeedsDecodeAndCoverEveryTable) {
     grid |= decoder.header().quantization == Quantization::Grid;
     connectivity |= c.hasSimplices();
     labelled |= decoder.header().labelled;
+    float64 |= decoder.header().float64() && !c.positions64.empty();
     for (const VertexAttribute& a : c.attributes) {
       exactAttribute |= a.quantization.kind == AttributeQuantization::Exact;
       uniform |= a.quantization.kind == AttributeQuantization::Uniform;
@@ -156,7 +157,7 @@ TEST(FuzzSeeds, DecoderSeedsDecodeAndCoverEveryTable) {
     }
     nonFinite |= std::any_of(c.positions.begin(), c.positions.end(), [](float x) { return !std::isfinite(x); });
   }
-  EXPECT_TRUE(grid && connectivity && exactAttribute && uniform && octahedral && labelled && nonFinite);
+  EXPECT_TRUE(grid && connectivity && exactAttribute && uniform && octahedral && labelled && nonFinite && float64);
 }
 
 }  // namespace

@@ -49,6 +49,12 @@ struct ReadOptions {
   // degenerate). STL welds each corner as it is read, so that a soup takes
   // memory for its distinct vertices rather than three per triangle.
   bool weld = false;
+  // Keep float64 coordinates: PLY `double` properties, Medit
+  // MeshVersionFormatted 2 and OBJ coordinates with more digits than
+  // float32 holds fill Complex::positions64 (exactly), positions holding
+  // their float32 roundings, for exact encoding. Without it they are
+  // rounded to float32, and a note says so. Other formats read float32.
+  bool keepDoubles = false;
 };
 
 // Format notes:
@@ -123,8 +129,11 @@ struct WriteOptions {
   bool asciiPly = false;
 };
 
-// Text formats print 9 significant digits, enough to give back every float32
-// bit; binary PLY stores float32 as is. A format that cannot hold some
+// Text formats print the shortest decimal that gives back every float32
+// bit (at most 9 significant digits); binary PLY stores float32 as is. A
+// complex with positions64 is written in doubles instead: PLY `double`
+// properties, Medit MeshVersionFormatted 2, VTK `double` points, other text
+// formats at most 17 significant digits. A format that cannot hold some
 // simplices of the complex (XYZ holds only vertices, OFF no tetrahedra) is an
 // InvalidArgument error rather than a silent loss. STL cannot be written.
 // TetGen: writeFile on x.node or x.ele writes x.node, plus x.ele when there

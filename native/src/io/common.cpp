@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <cstring>
 #include <limits>
 
@@ -123,28 +124,35 @@ int64_t decimalMagnitude(std::string_view number) {
   return magnitude;
 }
 
-// from_chars reports a value beyond float range without giving one; rounding
-// to nearest takes it to infinity when too large and to zero when too small.
-float roundOutOfRange(std::string_view number) {
-  float magnitude = decimalMagnitude(number) >= 0
-                        ? std::numeric_limits<float>::infinity()
-                        : 0.0f;
+// from_chars reports a value beyond the type's range without giving one;
+// rounding to nearest takes it to infinity when too large and to zero when
+// too small.
+template <class Real>
+Real roundOutOfRange(std::string_view number) {
+  Real magnitude = decimalMagnitude(number) >= 0
+                       ? std::numeric_limits<Real>::infinity()
+                       : Real(0);
   return number[0] == '-' ? -magnitude : magnitude;
 }
 
-}  // namespace
-
-bool parseFloat(std::string_view token, float& value) {
+// A float or double, rounded once from the decimal text.
+template <class Real>
+bool parseReal(std::string_view token, Real& value) {
   token = withoutPlus(token);
   const char* end = token.data() + token.size();
   auto [stop, error] = std::from_chars(token.data(), end, value);
   if (stop != end) return false;
   if (error == std::errc::result_out_of_range) {
-    value = roundOutOfRange(token);
+    value = roundOutOfRange<Real>(token);
     return true;
   }
   return error == std::errc();
 }
+
+}  // namespace
+
+bool parseFloat(std::string_view token, float& value) { return parseReal(token, value); }
+bool parseDouble(std::string_view token, double& value) { return parseReal(token, value); }
 
 bool parseInteger(std::string_view token, int64_t& value) {
   token = withoutPlus(token);
@@ -161,7 +169,7 @@ bool parseCount(std::string_view token, uint64_t& value) {
 }
 
 Status readPositionLine(TextScanner& scanner, std::vector<float>& positions,
-                        bool& extraColumns) {
+                        bool& extraColumns, std::vector<double>* exact, bool* beyondFloat) {
   float xyz[3];
   std::string_view token;
   for (int axis = 0; axis < 3; ++axis) {
@@ -173,6 +181,17 @@ Status readPositionLine(TextScanner& scanner, std::vector<float>& positions,
     if (!parseFloat(token, xyz[axis])) {
       return lineError(scanner.lineNumber(),
                        quoted(token) + " is not a number");
+    }
+    if (exact) {
+      // The token's double, and whether it says more than the shortest
+      // decimal of its float32 rounding does.
+      double value = 0, rounded = 0;
+      char shortest[32];
+      const auto printed = std::to_chars(shortest, shortest + sizeof shortest, xyz[axis]);
+      parseDouble(token, value);
+      parseDouble(std::string_view(shortest, size_t(printed.ptr - shortest)), rounded);
+      exact->push_back(value);
+      if (!(value == rounded) && !(std::isnan(value) && std::isnan(rounded))) *beyondFloat = true;
     }
   }
   positions.insert(positions.end(), xyz, xyz + 3);
@@ -342,6 +361,21 @@ TextOut& TextOut::real(float value) {
   char buffer[32];
   auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
   return word(std::string_view(buffer, result.ptr - buffer));
+}
+
+TextOut& TextOut::real(double value) {
+  char buffer[40];
+  auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
+  return word(std::string_view(buffer, result.ptr - buffer));
+}
+
+TextOut& TextOut::point(const Complex& complex, size_t vertex) {
+  if (complex.positions64.empty()) {
+    const float* xyz = &complex.positions[3 * vertex];
+    return real(xyz[0]).real(xyz[1]).real(xyz[2]);
+  }
+  const double* xyz = &complex.positions64[3 * vertex];
+  return real(xyz[0]).real(xyz[1]).real(xyz[2]);
 }
 
 TextOut& TextOut::integer(uint64_t value) {

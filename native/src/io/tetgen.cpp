@@ -412,10 +412,9 @@ Status writeTetgenNode(const Complex& complex, std::vector<uint8_t>& out) {
       .integer(columnCount)
       .integer(marker ? 1 : 0)
       .endLine();
-  const std::vector<float>& positions = complex.positions;
   for (size_t v = 0; v < complex.vertexCount(); ++v) {
     text.integer(v + 1)  // numbered from 1, as TetGen writes by default
-        .point(&positions[3 * v]);
+        .point(complex, v);
     for (const VertexAttribute* a : columns)
       for (size_t k = 0; k < a->components; ++k)
         text.value(AttributeType::Float32, &a->values[(v * a->components + k) * 4]);
