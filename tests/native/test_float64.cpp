@@ -273,9 +273,7 @@ void expectFileRoundTrip(io::Format format, const Complex& complex, const io::Wr
   const ReadResult rounded = readBytes(format, bytes);
   ASSERT_TRUE(rounded.status.ok());
   EXPECT_TRUE(rounded.complex.positions64.empty());
-  if (format != io::Format::Obj) {
-    EXPECT_TRUE(rounded.hasNote("rounded to float32")) << joined(rounded.notes);
-  }
+  EXPECT_TRUE(rounded.hasNote("rounded to float32")) << joined(rounded.notes);
 }
 
 TEST(Float64Files, PlyDoublesBinaryAndAscii) {
@@ -295,6 +293,11 @@ TEST(Float64Files, Float32FilesStayFloat32) {
   const ReadResult obj = readDoubles(io::Format::Obj, bytesOf("v 0.1 0.2 0.3\nv 1e-45 -0 3.4028235e38\nv nan inf -inf\n"));
   ASSERT_TRUE(obj.status.ok()) << obj.status.message;
   EXPECT_TRUE(obj.complex.positions64.empty());
+  EXPECT_TRUE(obj.notes.empty()) << joined(obj.notes);
+  const ReadResult roundedObj = readBytes(io::Format::Obj, bytesOf("v 0.1 0.2 0.3\nv 0.1000000001 0 0\n"));
+  ASSERT_TRUE(roundedObj.status.ok());
+  EXPECT_TRUE(roundedObj.complex.positions64.empty());
+  EXPECT_TRUE(roundedObj.hasNote("rounded to float32")) << joined(roundedObj.notes);
   const ReadResult longer = readDoubles(io::Format::Obj, bytesOf("v 0.1 0.2 0.3\nv 0.10000000000000001 0 0\nv 0.1000000001 0 0\n"));
   ASSERT_TRUE(longer.status.ok());
   ASSERT_EQ(longer.complex.positions64.size(), 9u);

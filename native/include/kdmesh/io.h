@@ -54,6 +54,9 @@ struct ReadOptions {
   // float32 holds fill Complex::positions64 (exactly), positions holding
   // their float32 roundings, for exact encoding. Without it they are
   // rounded to float32, and a note says so. Other formats read float32.
+  // (OBJ: a coordinate says more than float32 holds when its double
+  // differs from that of the shortest decimal of its float32 rounding, so
+  // a file written from floats, "0.1" included, reads as float32.)
   bool keepDoubles = false;
 };
 

@@ -149,6 +149,28 @@ bool parseReal(std::string_view token, Real& value) {
   return error == std::errc();
 }
 
+// Whether the decimal `token`, whose float32 rounding is `rounded`, says
+// more than the shortest decimal of `rounded` does. Up to 6 significant
+// digits never do (float32 keeps 6 decimal digits), which spares the
+// comparison for most files.
+bool beyondFloat32(std::string_view token, float rounded) {
+  int digits = 0;
+  bool leading = true;
+  for (const char c : token) {
+    if (c == 'e' || c == 'E') break;
+    if (!isDigit(c) || (leading && c == '0')) continue;
+    leading = false;
+    ++digits;
+  }
+  if (digits <= 6) return false;
+  double value = 0, shortest = 0;
+  char text[32];
+  const auto printed = std::to_chars(text, text + sizeof text, rounded);
+  parseReal(token, value);
+  parseReal(std::string_view(text, size_t(printed.ptr - text)), shortest);
+  return !(value == shortest) && !(std::isnan(value) && std::isnan(shortest));
+}
+
 }  // namespace
 
 bool parseFloat(std::string_view token, float& value) { return parseReal(token, value); }
@@ -183,16 +205,11 @@ Status readPositionLine(TextScanner& scanner, std::vector<float>& positions,
                        quoted(token) + " is not a number");
     }
     if (exact) {
-      // The token's double, and whether it says more than the shortest
-      // decimal of its float32 rounding does.
-      double value = 0, rounded = 0;
-      char shortest[32];
-      const auto printed = std::to_chars(shortest, shortest + sizeof shortest, xyz[axis]);
+      double value = 0;
       parseDouble(token, value);
-      parseDouble(std::string_view(shortest, size_t(printed.ptr - shortest)), rounded);
       exact->push_back(value);
-      if (!(value == rounded) && !(std::isnan(value) && std::isnan(rounded))) *beyondFloat = true;
     }
+    if (beyondFloat && !*beyondFloat) *beyondFloat = beyondFloat32(token, xyz[axis]);
   }
   positions.insert(positions.end(), xyz, xyz + 3);
   extraColumns = scanner.nextToken(token);

@@ -175,9 +175,9 @@ bool parseCount(std::string_view token, uint64_t& value);
 // Reads "x y z" from the rest of the current line onto `positions`. Returns
 // in `extraColumns` whether more tokens follow (w, colours, normals), which
 // the callers ignore with a note. With `exact`, also appends each
-// coordinate's double there and sets `*beyondFloat` when one holds more
-// than float32 does (its double differs from the double of the shortest
-// decimal of its float32 rounding: "0.1" is a float32 coordinate).
+// coordinate's double there. With `beyondFloat`, sets it when a coordinate
+// says more than float32 holds (its double differs from the double of the
+// shortest decimal of its float32 rounding: "0.1" is a float32 coordinate).
 Status readPositionLine(TextScanner& scanner, std::vector<float>& positions,
                         bool& extraColumns, std::vector<double>* exact = nullptr,
                         bool* beyondFloat = nullptr);
