@@ -17,15 +17,13 @@ cmake --build build-fuzz -j"$(nproc)" --target fuzz_decoder fuzz_readers
 corpus=build-fuzz/corpus
 mkdir -p "$corpus/decoder" "$corpus/readers"
 if [ -z "$(ls "$corpus/decoder")" ]; then
-  # Streams of every kind, small enough to mutate quickly.
+  # Streams of every kind, small enough to mutate quickly: a real model's,
+  # and the committed seed streams (scripts/fuzz-seeds.sh makes them).
   ./build/kdmesh encode build/models/triceratops.off -o "$corpus/decoder/mesh.kdm" --bits 8 --chunk-bytes 256 -q
   ./build/kdmesh encode build/models/triceratops.off -o "$corpus/decoder/points.kdm" --bits 10 --points-only -q
-  ./build/kdmesh encode tests/fuzz/seeds/mixed.obj -o "$corpus/decoder/mixed.kdm" --exact -q
-  ./build/kdmesh encode tests/fuzz/seeds/tetrahedra.mesh -o "$corpus/decoder/tetrahedra.kdm" --bits 6 -q
-  ./build/kdmesh encode tests/fuzz/seeds/colours.ply -o "$corpus/decoder/attributes.kdm" --exact -q
-  ./build/kdmesh encode tests/fuzz/seeds/regions.mesh -o "$corpus/decoder/labels.kdm" --exact -q
+  cp tests/fuzz/seeds/decoder/*.kdm "$corpus/decoder/"
   # Reader seeds: the first byte picks the format (see fuzz_readers.cpp).
-  for seed in tests/fuzz/seeds/*; do
+  for seed in tests/fuzz/seeds/*.*; do
     case "$seed" in
       *.ply) first='\000' ;; *.obj) first='\001' ;; *.off) first='\002' ;; *.xyz) first='\003' ;;
       *.stl) first='\004' ;; *.mesh) first='\005' ;; *.node) first='\006' ;; *.vtk) first='\007' ;;

@@ -174,6 +174,11 @@ EMSCRIPTEN_KEEPALIVE void kdm_progress(KdmDecoder* d, double* out) {
 EMSCRIPTEN_KEEPALIVE void kdm_snapshot(KdmDecoder* d) { d->decoder.snapshot(d->snapshot); }
 EMSCRIPTEN_KEEPALIVE uint32_t kdm_vertex_count(KdmDecoder* d) { return uint32_t(d->snapshot.vertexCount()); }
 EMSCRIPTEN_KEEPALIVE const float* kdm_positions(KdmDecoder* d) { return d->snapshot.positions.data(); }
+// A float64 stream's doubles, 3 per vertex (the snapshot's positions64),
+// or null for other streams.
+EMSCRIPTEN_KEEPALIVE const double* kdm_positions64(KdmDecoder* d) {
+  return d->snapshot.positions64.empty() ? nullptr : d->snapshot.positions64.data();
+}
 // Number of indices (not simplices) of dimension 0..3 in the snapshot.
 EMSCRIPTEN_KEEPALIVE uint32_t kdm_index_count(KdmDecoder* d, int dimension) {
   return uint32_t(indices(d->snapshot, dimension).size());

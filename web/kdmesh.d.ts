@@ -86,8 +86,10 @@ export interface Progress {
 
 export interface Model {
   vertexCount: number;
-  /** xyz, 3 floats per vertex. */
+  /** xyz, 3 floats per vertex (a float64 stream's float32 roundings). */
   positions: Float32Array;
+  /** Float64 streams only: xyz, 3 doubles per vertex, exact once complete. */
+  positions64?: Float64Array;
   /** Isolated vertices. */
   points: Uint32Array;
   /** 2 indices per edge. */

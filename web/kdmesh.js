@@ -255,8 +255,10 @@ export class Decoder {
   }
 
   /**
-   * The model at the current level: { vertexCount, positions, points, edges,
-   * triangles, tetrahedra, attributes, labels?, complete, stats }. `labels`
+   * The model at the current level: { vertexCount, positions, positions64?,
+   * points, edges, triangles, tetrahedra, attributes, labels?, complete,
+   * stats }. `positions64` (float64 streams only) is a Float64Array of the
+   * exact doubles once complete (before, `positions` widened). `labels`
    * (streams with simplex labels only) holds { edges, triangles, tetrahedra },
    * an Int32Array of one label per simplex of each list. `attributes` maps
    * each vertex attribute's name to { array, itemSize, coding, codingBits }:
@@ -310,6 +312,8 @@ export class Decoder {
         bitsPerVertex: vertexCount ? (8 * progress.bytesConsumed) / vertexCount : 0,
       },
     };
+    const doubles = m._kdm_positions64(h);
+    if (doubles) model.positions64 = take(new Float64Array(m.HEAPU8.buffer, doubles, 3 * vertexCount));
     if (this.header?.labelled) {
       const labels = (dimension) => {
         const count = m._kdm_label_count(h, dimension);

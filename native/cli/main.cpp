@@ -196,6 +196,7 @@ int runEncode(const EncodeArgs& args) {
   kdmesh::io::Notes notes;
   kdmesh::io::ReadOptions readOptions;
   readOptions.weld = args.weld;
+  readOptions.keepDoubles = args.exact;  // float64 coordinates make a float64 stream
   if (auto s = kdmesh::io::readFile(args.input, complex, notes, readOptions); !s.ok())
     return fail(s, args.input);
   for (const std::string& n : notes) note(args.input + ": " + n);
@@ -407,7 +408,7 @@ int runInfo(const std::string& input, bool json, bool perLevel) {
     std::printf("  \"maxDimension\": %u,\n  \"simplexCounts\": [%u, %u, %u, %u],\n",
                 unsigned(h.maxDimension), h.simplexCounts[0], h.simplexCounts[1],
                 h.simplexCounts[2], h.simplexCounts[3]);
-    std::printf("  \"quantization\": \"%s\",\n  \"bits\": %u,\n", grid ? "grid" : "float32",
+    std::printf("  \"quantization\": \"%s\",\n  \"bits\": %u,\n", grid ? "grid" : h.float64() ? "float64" : "float32",
                 unsigned(h.bits));
     std::printf("  \"axisBits\": [%d, %d, %d],\n", h.axisBits(0), h.axisBits(1), h.axisBits(2));
     if (grid)
@@ -469,8 +470,9 @@ int runInfo(const std::string& input, bool json, bool perLevel) {
                 unsigned(h.bits), h.axisBits(0), h.axisBits(1), h.axisBits(2), h.step, h.origin[0],
                 h.origin[1], h.origin[2]);
   else
-    std::printf("quantization    exact float32 (x %d, y %d, z %d bits of float image)\n",
-                h.axisBits(0), h.axisBits(1), h.axisBits(2));
+    std::printf("quantization    exact %s (x %d, y %d, z %d bits of float32 image%s)\n",
+                h.float64() ? "float64" : "float32", h.axisBits(0), h.axisBits(1), h.axisBits(2),
+                h.float64() ? ", then residuals" : "");
   std::printf("kd-tree levels  %d\n", h.depth());
   double attributeBits = 0;
   for (const double bits : cost.attributeBits) attributeBits += bits;
@@ -575,7 +577,10 @@ int main(int argc, char** argv) {
                                   "Grid bits of the longest bounding-box axis (1-30)")
                    ->check(CLI::Range(1, 30))
                    ->capture_default_str();
-  encode->add_flag("--exact", encodeArgs.exact, "Keep every float32 coordinate bit-exact")->excludes(bits);
+  encode->add_flag("--exact", encodeArgs.exact,
+                   "Keep every coordinate bit-exact (float64 ones of PLY double, Medit version 2 and "
+                   "long OBJ decimals too)")
+      ->excludes(bits);
   encode->add_option("--chunk-bytes", encodeArgs.chunkBytes,
                      "Largest chunk payload in bytes; the first chunks start at 1 KiB")
       ->check(CLI::Range(64, 1 << 26))

@@ -80,12 +80,15 @@ Status validate(const Header& h, const DecoderLimits& limits) {
       if (!std::isfinite(float(double(h.origin[size_t(a)]) + double(h.gridMax[size_t(a)]) * h.step)))
         return corrupt("the grid's far corner is not a finite float32");
   } else if (h.quantization == Quantization::Float32) {
-    if (h.bits != 32) return corrupt("float32 mode must have 32 bits");
+    if (h.bits != 32 && h.bits != 64) return corrupt("float mode must have 32 or 64 bits");
+    // A float64 stream's residuals are two attributes.
+    if (h.float64() && h.attributeCount < 2) return corrupt("float64 mode without its residual attributes");
     for (int a = 0; a < 3; ++a) {
-      // Both ends of the coded range must be images of finite floats.
+      // Every 32-bit image is a float (infinities and NaNs included); the
+      // coded range must not run past the last one.
       const uint64_t low = h.floatImageMin[size_t(a)];
       const uint64_t high = low + h.gridMax[size_t(a)];
-      if (low < 0x00800000u || high > 0xff7fffffu) return corrupt("float range is not finite");
+      if (high > 0xffffffffu) return corrupt("float range runs past the largest float image");
     }
   } else {
     return corrupt("unknown quantization mode");

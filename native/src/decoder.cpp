@@ -507,16 +507,41 @@ struct Decoder::State {
         const double along = squared > 0 ? (m[0] * offset[0] + m[1] * offset[1] + m[2] * offset[2]) / squared : 0;
         for (size_t a = 0; a < 3; ++a) target[a] += squared > 0 ? along * m[a] : offset[a];
       }
+      // A float32 stream's infinite or NaN neighbours make no target: the
+      // vertex stays at its cell's centre. A cell bound that is not finite
+      // compares false, which leaves that side open, as the cell is.
       for (size_t a = 0; a < 3; ++a)
-        positions[i + a] = float(std::clamp(target[a], double(low[i + a]), double(high[i + a])));
+        positions[i + a] = std::isfinite(target[a])
+                               ? float(std::clamp(target[a], double(low[i + a]), double(high[i + a])))
+                               : centre[i + a];
     }
   }
 
-  // Replaces `out` with the model at the current level (Decoder::snapshot);
+  // Replaces `out` with the model at the current level (Decoder::snapshot):
+  // snapshotStream's, then, in a float64 stream, the doubles from the
+  // residual attributes (exact once complete; the float32 positions widened
+  // before that), which are left out of the attributes.
+  void snapshot(Complex& out, bool takeFinal) {
+    snapshotStream(out, takeFinal);
+    out.positions64.clear();
+    if (!hasHeader || !header.float64()) return;
+    if (out.attributes.size() < 2) {  // before the attribute table
+      out.positions64.assign(out.positions.begin(), out.positions.end());
+      return;
+    }
+    const size_t user = out.attributes.size() - 2;
+    if (complete())
+      joinFloat64(out.positions, out.attributes[user], out.attributes[user + 1], out.positions64);
+    else
+      out.positions64.assign(out.positions.begin(), out.positions.end());
+    out.attributes.resize(user);
+  }
+
+  // The stream's vertices (float32 positions), simplices and attributes;
   // once complete, `takeFinal` moves the simplex lists out instead of
   // copying them, for decode(), whose decoder is discarded next (the copy
   // was 12 bytes per triangle of peak memory).
-  void snapshot(Complex& out, bool takeFinal) {
+  void snapshotStream(Complex& out, bool takeFinal) {
     // Emptied, not replaced: a caller that snapshots level after level into
     // one Complex reuses its memory.
     for (std::vector<uint32_t>* list : {&out.points, &out.edges, &out.triangles, &out.tetrahedra}) list->clear();
@@ -611,6 +636,11 @@ struct Decoder::State {
         const Parsed read = readAttributeTable(at, available, header.attributeCount, attributes, tableBytes, status);
         if (read == Parsed::Incomplete) break;
         if (read == Parsed::Malformed) break;
+        if (header.float64() && !areResidualAttributes(attributes[attributes.size() - 2], attributes.back())) {
+          status = Status::error(ErrorCode::CorruptHeader,
+                                 "corrupt attribute table: a float64 stream must end it with its residuals");
+          break;
+        }
         attributeCoder.emplace(attributes);
         cost.attributeBits.assign(attributes.size(), 0.0);
         attributeTableRead = true;
@@ -710,7 +740,15 @@ bool Decoder::hasHeader() const { return state_->hasHeader; }
 const Header& Decoder::header() const { return state_->header; }
 bool Decoder::complete() const { return state_->complete(); }
 const std::vector<ChunkInfo>& Decoder::chunks() const { return state_->chunks; }
-CodingCost Decoder::cost() const { return state_->cost; }
+CodingCost Decoder::cost() const {
+  CodingCost cost = state_->cost;
+  // A float64 stream's residual attributes are geometry.
+  if (state_->hasHeader && state_->header.float64() && cost.attributeBits.size() >= 2) {
+    cost.geometryBits += cost.attributeBits[cost.attributeBits.size() - 1] + cost.attributeBits[cost.attributeBits.size() - 2];
+    cost.attributeBits.resize(cost.attributeBits.size() - 2);
+  }
+  return cost;
+}
 const std::vector<uint32_t>& Decoder::vertexParents() const { return state_->parents; }
 const std::vector<int32_t>& Decoder::labels() const { return state_->labelTable; }
 ConnectivityStatistics Decoder::statistics() const {
@@ -756,7 +794,8 @@ double Decoder::errorBound() const {
       const double half =
           (double(s.dequantizer->position(a, hi, hi)) - double(s.dequantizer->position(a, lo, lo))) * share +
           halfStep;
-      squared += half * half;
+      // A float32 cell that holds NaNs has no bound.
+      squared += std::isnan(half) ? INFINITY : half * half;
     }
     worst = std::max(worst, squared);
   });

@@ -26,6 +26,20 @@ constexpr size_t kFirstChunkBytes = 1024;
 constexpr size_t kMinChunkBytes = 64;
 constexpr size_t kMaxChunkBytes = size_t(1) << 26;
 
+// LimitExceeded when encodeMemoryEstimate() exceeds options.maxMemoryBytes.
+Status checkMemory(const Complex& complex, const EncodeOptions& options) {
+  const uint64_t needed = encodeMemoryEstimate(complex);
+  if (options.maxMemoryBytes != 0 && needed > options.maxMemoryBytes)
+    return Status::error(ErrorCode::LimitExceeded,
+                         "encoding " + std::to_string(complex.vertexCount()) + " vertices and " +
+                             std::to_string(complex.edges.size() / 2 + complex.triangles.size() / 3 +
+                                            complex.tetrahedra.size() / 4) +
+                             " simplices needs about " + std::to_string(needed >> 20) +
+                             " MiB of working memory, more than the limit of " +
+                             std::to_string(options.maxMemoryBytes >> 20) + " MiB");
+  return Status::success();
+}
+
 Status checkOptions(const Complex& complex, const EncodeOptions& options) {
   if (!options.exact && (options.bits < 1 || options.bits > 30))
     return Status::error(ErrorCode::InvalidArgument,
@@ -42,16 +56,7 @@ Status checkOptions(const Complex& complex, const EncodeOptions& options) {
     return Status::error(ErrorCode::InvalidInput, "more than 2^31 - 1 vertices");
   if (Status status = checkLabels(complex); !status.ok()) return status;
   if (Status status = checkAttributes(complex); !status.ok()) return status;
-  const uint64_t needed = encodeMemoryEstimate(complex);
-  if (options.maxMemoryBytes != 0 && needed > options.maxMemoryBytes)
-    return Status::error(ErrorCode::LimitExceeded,
-                         "encoding " + std::to_string(complex.vertexCount()) + " vertices and " +
-                             std::to_string(complex.edges.size() / 2 + complex.triangles.size() / 3 +
-                                            complex.tetrahedra.size() / 4) +
-                             " simplices needs about " + std::to_string(needed >> 20) +
-                             " MiB of working memory, more than the limit of " +
-                             std::to_string(options.maxMemoryBytes >> 20) + " MiB");
-  return Status::success();
+  return checkMemory(complex, options);
 }
 
 // Writes chunks into the stream body: a frame, then the payload that the
@@ -246,6 +251,15 @@ uint64_t encodeMemoryEstimate(const Complex& complex) {
   // Labels: the input's and the store's, 4 bytes each.
   bytes += 8 * uint64_t(complex.labels.edges.size() + complex.labels.triangles.size() +
                         complex.labels.tetrahedra.size());
+  // Float64: the doubles, and the copy that exact encoding codes (float32
+  // positions, 24 bytes of residuals per vertex, lists, labels, values).
+  if (!complex.positions64.empty()) {
+    bytes += 8 * uint64_t(complex.positions64.size()) + uint64_t(complex.vertexCount()) * (12 + 24) +
+             4 * uint64_t(complex.edges.size() + complex.triangles.size() + complex.tetrahedra.size() +
+                          complex.points.size() + complex.labels.edges.size() + complex.labels.triangles.size() +
+                          complex.labels.tetrahedra.size());
+    for (const VertexAttribute& attribute : complex.attributes) bytes += attribute.values.size();
+  }
   return bytes;
 }
 
@@ -253,7 +267,12 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options) {
   return encode(complex, options, nullptr);
 }
 
-EncodeResult encode(const Complex& complex, const EncodeOptions& options, TrainedModels* finalModels) {
+namespace {
+
+// Encodes `complex`'s float32 positions; a float64 stream (`float64`) has
+// its residual attributes last among complex.attributes.
+EncodeResult encodeStream(const Complex& complex, const EncodeOptions& options, TrainedModels* finalModels,
+                          bool float64) {
   EncodeResult result;
   if (result.status = checkOptions(complex, options); !result.status.ok()) return result;
   std::vector<AttributeQuantization> quantization;  // how each attribute is coded
@@ -269,6 +288,7 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
   report("quantize", 0);
   if (result.status = quantize(complex.positions, options, header, coords); !result.status.ok())
     return result;
+  if (float64) header.bits = 64;
   const SplitSchedule schedule(header);
   report("sort", 0);
   KdOrder order = kdOrder(coords, schedule);
@@ -443,6 +463,46 @@ EncodeResult encode(const Complex& complex, const EncodeOptions& options, Traine
   const size_t headerBytes = writeHeader(header, result.bytes.data());
   result.bytes.resize(headerBytes);
   result.bytes.insert(result.bytes.end(), body.begin(), body.end());
+  return result;
+}
+
+}  // namespace
+
+EncodeResult encode(const Complex& complex, const EncodeOptions& options, TrainedModels* finalModels) {
+  if (!options.exact || complex.positions64.empty()) return encodeStream(complex, options, finalModels, false);
+  EncodeResult result;
+  auto fail = [&](ErrorCode code, std::string message) {
+    result.status = Status::error(code, std::move(message));
+    return result;
+  };
+  if (complex.positions64.size() != complex.positions.size())
+    return fail(ErrorCode::InvalidArgument, "positions64 must be empty or hold 3 doubles per vertex, as positions");
+  if (complex.attributes.size() > kMaxAttributes - 2)
+    return fail(ErrorCode::InvalidInput, "a float64 stream holds at most " + std::to_string(kMaxAttributes - 2) +
+                                             " attributes (its coordinates' residuals take two)");
+  for (const VertexAttribute& a : complex.attributes)
+    if (a.name == kResidualNames[0] || a.name == kResidualNames[1])
+      return fail(ErrorCode::InvalidInput, "the attribute name '" + a.name + "' is reserved for float64 residuals");
+  // The copy below is counted in the estimate: refuse before making it.
+  if (result.status = checkMemory(complex, options); !result.status.ok()) return result;
+  // The kd-tree codes the float32 roundings; the residuals go last among
+  // the attributes, and their bits count as geometry.
+  Complex widened;
+  widened.points = complex.points;
+  widened.edges = complex.edges;
+  widened.triangles = complex.triangles;
+  widened.tetrahedra = complex.tetrahedra;
+  widened.labels = complex.labels;
+  widened.attributes = complex.attributes;
+  widened.attributes.resize(complex.attributes.size() + 2);
+  splitFloat64(complex.positions64, widened.positions, widened.attributes[complex.attributes.size()],
+               widened.attributes[complex.attributes.size() + 1]);
+  result = encodeStream(widened, options, finalModels, true);
+  if (result.status.ok()) {
+    std::vector<double>& bits = result.cost.attributeBits;
+    result.cost.geometryBits += bits[bits.size() - 1] + bits[bits.size() - 2];
+    bits.resize(bits.size() - 2);
+  }
   return result;
 }
 

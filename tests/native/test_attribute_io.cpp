@@ -333,6 +333,67 @@ TEST(AttributeIoTetgen, AttributesAndMarkersRoundTripWithTheNarrowestMarkerType)
   EXPECT_EQ(io::writeFile((dir / "block.node").string(), block).code, ErrorCode::InvalidArgument);
 }
 
+TEST(AttributeIoTetgen, EveryColumnMarkerAndRegionSurviveEncodeAndDecode) {
+  // Nine point attribute columns (attribute_0 and attribute_4 of 4, attribute_8
+  // of 1), boundary markers and region labels.
+  Complex block = tetrahedralBlock(3, 7);
+  const size_t n = block.vertexCount();
+  std::vector<float> first, second, third;
+  std::vector<int32_t> markers;
+  for (size_t v = 0; v < n; ++v) {
+    const float* p = &block.positions[3 * v];
+    first.insert(first.end(), {p[0] * 0.3f, float(v) * -1e-3f, 1e30f, -0.0f});
+    second.insert(second.end(), {p[1] + p[2], 1.0f / float(v + 1), float(v % 3), INFINITY});
+    third.push_back(float(v) * 7.25f);
+    markers.push_back(int32_t(v * 997 % 70000) - 1000);
+  }
+  block.attributes = {attribute("attribute_0", AttributeType::Float32, 4, first),
+                      attribute("attribute_4", AttributeType::Float32, 4, second),
+                      attribute("attribute_8", AttributeType::Float32, 1, third),
+                      attribute("marker", AttributeType::Int32, 1, markers)};
+  for (size_t t = 0; t < block.tetrahedra.size() / 4; ++t) block.labels.tetrahedra.push_back(int32_t(t % 5) - 2);
+
+  TempDir dir;
+  ASSERT_TRUE(io::writeFile((dir / "block.ele").string(), block).ok());
+  const ReadResult read = readPath(dir / "block.node");
+  ASSERT_TRUE(read.status.ok()) << read.status.message;
+  EXPECT_TRUE(read.notes.empty()) << joined(read.notes);
+  expectSameDescriptors(block, read.complex);
+  EXPECT_EQ(bitsOf(read.complex.positions), bitsOf(block.positions));
+  EXPECT_EQ(vertexKeys(read.complex), vertexKeys(block));
+  EXPECT_EQ(read.complex.tetrahedra, block.tetrahedra);
+  EXPECT_EQ(read.complex.labels.tetrahedra, block.labels.tetrahedra);
+
+  // Through the codec and back to files: the same vertices, values,
+  // tetrahedra and labels, up to vertex order.
+  EncodeOptions exact;
+  exact.exact = true;
+  expectRoundTrip(read.complex, exact);
+  const EncodeResult encoded = encode(read.complex, exact);
+  ASSERT_TRUE(encoded.status.ok()) << encoded.status.message;
+  Complex decoded;
+  ASSERT_TRUE(decode(encoded.bytes.data(), encoded.bytes.size(), decoded).ok());
+  ASSERT_TRUE(io::writeFile((dir / "decoded.node").string(), decoded).ok());
+  const ReadResult back = readPath(dir / "decoded.ele");
+  ASSERT_TRUE(back.status.ok()) << back.status.message;
+  expectSameDescriptors(block, back.complex);
+  EXPECT_EQ(vertexKeys(back.complex), vertexKeys(decoded));
+  EXPECT_EQ(back.complex.tetrahedra, decoded.tetrahedra);
+  EXPECT_EQ(back.complex.labels.tetrahedra, decoded.labels.tetrahedra);
+  EXPECT_EQ(canonicalForm(back.complex), canonicalForm(block));
+
+  // Columns the reader would name otherwise are refused, not renamed.
+  Complex gap = block;
+  gap.attributes.erase(gap.attributes.begin() + 1);  // attribute_0, attribute_8
+  EXPECT_EQ(io::writeFile((dir / "gap.node").string(), gap).code, ErrorCode::InvalidArgument);
+  Complex short0 = block;
+  short0.attributes.erase(short0.attributes.begin() + 1, short0.attributes.begin() + 3);  // attribute_0 alone
+  EXPECT_EQ(io::writeFile((dir / "short.node").string(), short0).code, ErrorCode::InvalidArgument);
+  Complex misnamed = block;
+  misnamed.attributes[2].name = "attribute_9";
+  EXPECT_EQ(io::writeFile((dir / "misnamed.node").string(), misnamed).code, ErrorCode::InvalidArgument);
+}
+
 TEST(AttributeIoMedit, VertexReferencesRoundTrip) {
   for (const int64_t largest : {int64_t{200}, int64_t{-5}, int64_t{70000}, int64_t{3000000000}}) {
     Complex block = tetrahedralBlock(3, 6);

@@ -213,6 +213,28 @@ TEST_F(CliTest, ExactRoundTripThroughEveryOutputFormatIsBitExact) {
   }
 }
 
+TEST_F(CliTest, ExactKeepsFloat64CoordinatesAndGridRoundsThemWithANote) {
+  // Doubles below float32 precision, as Medit version 2 and PLY double.
+  writeWhole(at("m.mesh"),
+             "MeshVersionFormatted 2\nDimension 3\nVertices\n4\n0.1 0 0 1\n1 0.30000000000000004 0 1\n"
+             "0 1 1e-300 1\n0 0 1.0000000000000002 1\nTetrahedra\n1\n1 2 3 4 0\nEnd\n");
+  runOk("encode m.mesh -o m.kdm --exact");
+  EXPECT_NE(runOk("info m.kdm").out.find("exact float64"), std::string::npos);
+  for (const char* output : {"out.mesh", "out.ply"}) {
+    SCOPED_TRACE(output);
+    runOk(std::string("decode m.kdm -o ") + output);
+    runOk(std::string("encode ") + output + " -o again.kdm --exact");
+    runOk("decode again.kdm -o again.mesh");
+    const std::string text = readWhole(at("again.mesh"));
+    EXPECT_EQ(text.rfind("MeshVersionFormatted 2", 0), 0u) << text;
+    for (const char* value : {"0.1 ", "0.30000000000000004", "1e-300", "1.0000000000000002"})
+      EXPECT_NE(text.find(value), std::string::npos) << value << " in " << text;
+  }
+  const CliRun grid = runOk("encode m.mesh -o grid.kdm");
+  EXPECT_NE(grid.err.find("rounded to float32"), std::string::npos) << grid.err;
+  EXPECT_NE(runOk("info grid.kdm").out.find("grid"), std::string::npos);
+}
+
 TEST_F(CliTest, GridRoundTripIsWithinHalfAStep) {
   const std::vector<float> input = sphereSurface(5000, 32);
   writeModel("sphere.ply", pointCloud(input));

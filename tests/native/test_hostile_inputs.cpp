@@ -2,7 +2,11 @@
 // error or a correct result (ctest gives every test a time limit).
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
 #include <string>
+#include <vector>
 
 #include "complexes.h"
 #include "io_test_support.h"
@@ -120,6 +124,40 @@ TEST(HostileInputs, ZeroVerticesAndOutOfRangeIndicesAreErrors) {
   const EncodeResult r = encode(c, EncodeOptions{});
   EXPECT_EQ(r.status.code, ErrorCode::InvalidInput);
   EXPECT_NE(r.status.message.find("tetrahedron 0"), std::string::npos) << r.status.message;
+}
+
+// The decoder fuzzer's committed seed streams (scripts/fuzz-seeds.sh) are
+// of the current format and, together, reach every table and coding path
+// the fuzzer should mutate.
+TEST(FuzzSeeds, DecoderSeedsDecodeAndCoverEveryTable) {
+  std::vector<std::filesystem::path> streams;
+  for (const auto& entry : std::filesystem::directory_iterator(std::filesystem::path(KDMESH_FUZZ_SEEDS) / "decoder"))
+    if (entry.path().extension() == ".kdm") streams.push_back(entry.path());
+  std::sort(streams.begin(), streams.end());
+  ASSERT_GE(streams.size(), 7u);
+  bool grid = false, connectivity = false, exactAttribute = false, uniform = false, octahedral = false,
+       labelled = false, nonFinite = false, float64 = false;
+  for (const std::filesystem::path& path : streams) {
+    SCOPED_TRACE(path.filename().string());
+    std::vector<uint8_t> bytes;
+    ASSERT_TRUE(io::readBytes(path.string(), bytes).ok());
+    Decoder decoder;
+    const Status pushed = decoder.push(bytes.data(), bytes.size());
+    ASSERT_TRUE(pushed.ok() && decoder.finish().ok())
+        << pushed.message << " (regenerate the seeds: sh scripts/fuzz-seeds.sh)";
+    const Complex c = decoder.snapshot();
+    grid |= decoder.header().quantization == Quantization::Grid;
+    connectivity |= c.hasSimplices();
+    labelled |= decoder.header().labelled;
+    float64 |= decoder.header().float64() && !c.positions64.empty();
+    for (const VertexAttribute& a : c.attributes) {
+      exactAttribute |= a.quantization.kind == AttributeQuantization::Exact;
+      uniform |= a.quantization.kind == AttributeQuantization::Uniform;
+      octahedral |= a.quantization.kind == AttributeQuantization::Octahedral;
+    }
+    nonFinite |= std::any_of(c.positions.begin(), c.positions.end(), [](float x) { return !std::isfinite(x); });
+  }
+  EXPECT_TRUE(grid && connectivity && exactAttribute && uniform && octahedral && labelled && nonFinite && float64);
 }
 
 }  // namespace

@@ -385,6 +385,23 @@ TEST(Stream, HostileHeadersAreRefusedBeforeAnyAllocation) {
     EXPECT_NE(s.message.find("not a finite float32"), std::string::npos) << s.message;
   }
 
+  // Float32 ranges may cover every image, infinities and NaNs included, but
+  // not run past the largest.
+  h = validHeader();
+  h.quantization = Quantization::Float32;
+  h.bits = 32;
+  h.floatImageMin = {0, 0x7f800000u, 2};
+  h.gridMax = {0xffffffffu, 5, 0xfffffffdu};
+  size = writeHeader(h, buffer);
+  Decoder everyFloat;
+  EXPECT_TRUE(everyFloat.push(buffer, size).ok());
+  h.gridMax[2] = 0xfffffffeu;
+  size = writeHeader(h, buffer);
+  Decoder pastTheEnd;
+  const Status past = pastTheEnd.push(buffer, size);
+  EXPECT_EQ(past.code, ErrorCode::CorruptHeader);
+  EXPECT_NE(past.message.find("runs past the largest float image"), std::string::npos) << past.message;
+
   // More vertices or simplices than the stream's size can justify (a
   // 49-byte stream announcing 2^27 − 1 coincident points was a 3.7 GB
   // decompression bomb); within the ratio DecoderLimits allows, accepted.

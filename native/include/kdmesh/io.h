@@ -49,6 +49,15 @@ struct ReadOptions {
   // degenerate). STL welds each corner as it is read, so that a soup takes
   // memory for its distinct vertices rather than three per triangle.
   bool weld = false;
+  // Keep float64 coordinates: PLY `double` properties, Medit
+  // MeshVersionFormatted 2 and OBJ coordinates with more digits than
+  // float32 holds fill Complex::positions64 (exactly), positions holding
+  // their float32 roundings, for exact encoding. Without it they are
+  // rounded to float32, and a note says so. Other formats read float32.
+  // (OBJ: a coordinate says more than float32 holds when its double
+  // differs from that of the shortest decimal of its float32 rounding, so
+  // a file written from floats, "0.1" included, reads as float32.)
+  bool keepDoubles = false;
 };
 
 // Format notes:
@@ -71,7 +80,9 @@ struct ReadOptions {
 //   The .node point attributes become the attribute `attribute` (float32,
 //   up to 4 components; more are grouped by 4 as `attribute_0`,
 //   `attribute_4`, ...) and the boundary markers `marker`, of the narrowest
-//   integer type that holds them; the writer writes both back. Region
+//   integer type that holds them; the writer writes every column and the
+//   markers back (attributes named otherwise than the reader names them are
+//   refused rather than renamed). Region
 //   attributes of the .ele are counted in a note.
 //   readMemory can read one buffer only, so it reads a .node alone.
 // - VTK: legacy ascii UNSTRUCTURED_GRID or POLYDATA, cells in the classic
@@ -111,7 +122,7 @@ Status readFile(const std::string& path, Complex& out, Notes& notes,
 // OBJ `uv` (float32 × 2 or 3, as vt) and `normal` (float32 × 3, as vn); VTK
 // any whose name has no space; Medit `ref` and TetGen `marker` (integers, 1
 // component; read back as the narrowest type that holds their values) and
-// TetGen `attribute` (float32). (Text keeps a NaN's sign, not its payload.)
+// TetGen `attribute` or `attribute_0`, `attribute_4`, ... (float32). (Text keeps a NaN's sign, not its payload.)
 // Writers refuse a complex with an attribute their format cannot hold
 // (InvalidArgument) rather than drop it.
 bool holdsAttribute(Format format, const VertexAttribute& attribute);
@@ -121,8 +132,11 @@ struct WriteOptions {
   bool asciiPly = false;
 };
 
-// Text formats print 9 significant digits, enough to give back every float32
-// bit; binary PLY stores float32 as is. A format that cannot hold some
+// Text formats print the shortest decimal that gives back every float32
+// bit (at most 9 significant digits); binary PLY stores float32 as is. A
+// complex with positions64 is written in doubles instead: PLY `double`
+// properties, Medit MeshVersionFormatted 2, VTK `double` points, other text
+// formats at most 17 significant digits. A format that cannot hold some
 // simplices of the complex (XYZ holds only vertices, OFF no tetrahedra) is an
 // InvalidArgument error rather than a silent loss. STL cannot be written.
 // TetGen: writeFile on x.node or x.ele writes x.node, plus x.ele when there

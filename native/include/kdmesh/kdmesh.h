@@ -98,6 +98,13 @@ struct SimplexLabels {
 
 struct Complex {
   std::vector<float> positions;  // xyz, 3 floats per vertex
+  // Float64 coordinates: empty, or 3 doubles per vertex, the exact values
+  // of which `positions` holds the float32 roundings. Readers fill it when
+  // ReadOptions::keepDoubles is set and the file holds coordinates that
+  // float32 does not; exact encoding (EncodeOptions::exact) of a complex
+  // with it makes a float64 stream (Header::float64()), and decoding one
+  // fills it.
+  std::vector<double> positions64;
   std::vector<uint32_t> points;
   std::vector<uint32_t> edges;
   std::vector<uint32_t> triangles;
@@ -119,7 +126,7 @@ struct Complex {
 enum class ErrorCode : uint8_t {
   Ok = 0,
   InvalidArgument,     // an option is out of range
-  InvalidInput,        // the complex cannot be encoded (NaN, bad index, ...)
+  InvalidInput,        // the complex cannot be encoded (NaN on a grid, bad index, ...)
   Unsupported,         // valid input that this version cannot encode
   BadMagic,            // the bytes are not a kdmesh stream
   UnsupportedVersion,  // a kdmesh stream from a newer format version
@@ -160,7 +167,8 @@ struct Header {
   uint16_t version = 0;
   uint8_t headerBytes = 0;          // the header's own size (it varies with its values)
   Quantization quantization = Quantization::Grid;
-  uint8_t bits = 0;                 // grid bits of the longest axis (Grid)
+  uint8_t bits = 0;                 // grid bits of the longest axis (Grid);
+                                    // 32, or 64 for float64 (Float32)
   uint32_t vertexCount = 0;
   uint8_t maxDimension = 0;         // highest simplex dimension present
   std::array<uint32_t, 4> simplexCounts{};  // per dimension 0..3; [0] counts
@@ -178,6 +186,10 @@ struct Header {
   // (the distinct labels) follows the attribute table.
   bool labelled = false;
 
+  // Float32 mode with float64 residuals (bits 64): the kd-tree codes each
+  // coordinate's float32 rounding, and two hidden attributes at the end of
+  // the table (counted in attributeCount) the rest of its float64 bits.
+  bool float64() const { return quantization == Quantization::Float32 && bits == 64; }
   // Bits of integer coordinate per axis: the kd-tree refines axis a
   // axisBits(a) times.
   int axisBits(int axis) const;
@@ -206,7 +218,11 @@ struct EncodeOptions {
   // error below 1/131070 of the largest extent: finer than float32 rendering
   // of a typical scan, and half the size of raw float32 coordinates.
   int bits = 16;
-  // Preserve every float32 coordinate bit for bit (overrides `bits`).
+  // Preserve every float32 coordinate bit for bit (overrides `bits`),
+  // infinities and NaNs (with their payloads) included; grid mode refuses
+  // them. A complex with positions64 keeps every float64 bit (a float64
+  // stream, whose vertices cost about nothing more while their doubles are
+  // float32 values); it may then have at most kMaxAttributes - 2 attributes.
   bool exact = false;
   // Float32 vertex attributes are exact unless these are set (lossy):
   // `attributeBits` (1..24) quantizes each component of every float32
@@ -417,7 +433,9 @@ class Decoder {
   // The model at the current level: one vertex in every current kd-tree
   // cell (clamped to the bounding box), placed as DecoderOptions::
   // coarsePlacement says, or, once complete, every input vertex at its exact
-  // (quantized) position. Replaces `out`.
+  // (quantized) position. Replaces `out`. A float64 stream's snapshot
+  // also fills positions64: the exact doubles once complete, before that
+  // the float32 positions widened.
   // With connectivity, vertex v of the snapshot is vertex id v, and the
   // simplices are the maximal simplices of the current complex (the input
   // complex with every vertex replaced by its cell), oriented as the input

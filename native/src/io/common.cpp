@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <charconv>
+#include <cmath>
 #include <cstring>
 #include <limits>
 
@@ -123,28 +124,57 @@ int64_t decimalMagnitude(std::string_view number) {
   return magnitude;
 }
 
-// from_chars reports a value beyond float range without giving one; rounding
-// to nearest takes it to infinity when too large and to zero when too small.
-float roundOutOfRange(std::string_view number) {
-  float magnitude = decimalMagnitude(number) >= 0
-                        ? std::numeric_limits<float>::infinity()
-                        : 0.0f;
+// from_chars reports a value beyond the type's range without giving one;
+// rounding to nearest takes it to infinity when too large and to zero when
+// too small.
+template <class Real>
+Real roundOutOfRange(std::string_view number) {
+  Real magnitude = decimalMagnitude(number) >= 0
+                       ? std::numeric_limits<Real>::infinity()
+                       : Real(0);
   return number[0] == '-' ? -magnitude : magnitude;
 }
 
-}  // namespace
-
-bool parseFloat(std::string_view token, float& value) {
+// A float or double, rounded once from the decimal text.
+template <class Real>
+bool parseReal(std::string_view token, Real& value) {
   token = withoutPlus(token);
   const char* end = token.data() + token.size();
   auto [stop, error] = std::from_chars(token.data(), end, value);
   if (stop != end) return false;
   if (error == std::errc::result_out_of_range) {
-    value = roundOutOfRange(token);
+    value = roundOutOfRange<Real>(token);
     return true;
   }
   return error == std::errc();
 }
+
+// Whether the decimal `token`, whose float32 rounding is `rounded`, says
+// more than the shortest decimal of `rounded` does. Up to 6 significant
+// digits never do (float32 keeps 6 decimal digits), which spares the
+// comparison for most files.
+bool beyondFloat32(std::string_view token, float rounded) {
+  int digits = 0;
+  bool leading = true;
+  for (const char c : token) {
+    if (c == 'e' || c == 'E') break;
+    if (!isDigit(c) || (leading && c == '0')) continue;
+    leading = false;
+    ++digits;
+  }
+  if (digits <= 6) return false;
+  double value = 0, shortest = 0;
+  char text[32];
+  const auto printed = std::to_chars(text, text + sizeof text, rounded);
+  parseReal(token, value);
+  parseReal(std::string_view(text, size_t(printed.ptr - text)), shortest);
+  return !(value == shortest) && !(std::isnan(value) && std::isnan(shortest));
+}
+
+}  // namespace
+
+bool parseFloat(std::string_view token, float& value) { return parseReal(token, value); }
+bool parseDouble(std::string_view token, double& value) { return parseReal(token, value); }
 
 bool parseInteger(std::string_view token, int64_t& value) {
   token = withoutPlus(token);
@@ -161,7 +191,7 @@ bool parseCount(std::string_view token, uint64_t& value) {
 }
 
 Status readPositionLine(TextScanner& scanner, std::vector<float>& positions,
-                        bool& extraColumns) {
+                        bool& extraColumns, std::vector<double>* exact, bool* beyondFloat) {
   float xyz[3];
   std::string_view token;
   for (int axis = 0; axis < 3; ++axis) {
@@ -174,6 +204,12 @@ Status readPositionLine(TextScanner& scanner, std::vector<float>& positions,
       return lineError(scanner.lineNumber(),
                        quoted(token) + " is not a number");
     }
+    if (exact) {
+      double value = 0;
+      parseDouble(token, value);
+      exact->push_back(value);
+    }
+    if (beyondFloat && !*beyondFloat) *beyondFloat = beyondFloat32(token, xyz[axis]);
   }
   positions.insert(positions.end(), xyz, xyz + 3);
   extraColumns = scanner.nextToken(token);
@@ -342,6 +378,21 @@ TextOut& TextOut::real(float value) {
   char buffer[32];
   auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
   return word(std::string_view(buffer, result.ptr - buffer));
+}
+
+TextOut& TextOut::real(double value) {
+  char buffer[40];
+  auto result = std::to_chars(buffer, buffer + sizeof buffer, value);
+  return word(std::string_view(buffer, result.ptr - buffer));
+}
+
+TextOut& TextOut::point(const Complex& complex, size_t vertex) {
+  if (complex.positions64.empty()) {
+    const float* xyz = &complex.positions[3 * vertex];
+    return real(xyz[0]).real(xyz[1]).real(xyz[2]);
+  }
+  const double* xyz = &complex.positions64[3 * vertex];
+  return real(xyz[0]).real(xyz[1]).real(xyz[2]);
 }
 
 TextOut& TextOut::integer(uint64_t value) {

@@ -69,6 +69,10 @@ Status checkWritable(const Complex& complex) {
                       std::to_string(complex.positions.size()) +
                       " floats, not a multiple of 3");
   }
+  if (!complex.positions64.empty() && complex.positions64.size() != complex.positions.size()) {
+    return inputError("positions64 hold " + std::to_string(complex.positions64.size()) + " doubles for " +
+                      std::to_string(complex.positions.size()) + " floats");
+  }
   const size_t vertexCount = complex.vertexCount();
   for (Status status :
        {checkIndices(complex.points, 1, vertexCount, "point"),
@@ -117,7 +121,7 @@ HeadCheck headCheckOf(Format format) {
 
 // Runs the reader of `format` on `input`, which is not blank.
 Status readFormat(Format format, Input& input, Complex& out, Notes& notes,
-                  bool weld) {
+                  const ReadOptions& options) {
   if (const HeadCheck check = headCheckOf(format)) {
     const Bytes head = input.head();
     if (Status status = check(head.data, head.size); !status.ok()) {
@@ -125,15 +129,15 @@ Status readFormat(Format format, Input& input, Complex& out, Notes& notes,
     }
   }
   // STL and PLY read what they need; the others parse all the text.
-  if (format == Format::Stl) return detail::readStl(input, out, notes, weld);
-  if (format == Format::Ply) return detail::readPly(input, out, notes);
+  if (format == Format::Stl) return detail::readStl(input, out, notes, options.weld);
+  if (format == Format::Ply) return detail::readPly(input, out, notes, options.keepDoubles);
   const Bytes all = input.whole();
   switch (format) {
-    case Format::Obj: return detail::readObj(all.data, all.size, out, notes);
+    case Format::Obj: return detail::readObj(all.data, all.size, out, notes, options.keepDoubles);
     case Format::Off: return detail::readOff(all.data, all.size, out, notes);
     case Format::Xyz: return detail::readXyz(all.data, all.size, out, notes);
     case Format::Medit:
-      return detail::readMedit(all.data, all.size, out, notes);
+      return detail::readMedit(all.data, all.size, out, notes, options.keepDoubles);
     case Format::Vtk: return detail::readVtk(all.data, all.size, out, notes);
     case Format::TetGen: {  // one buffer: the .node file alone
       uint32_t firstIndex = 0;
@@ -152,7 +156,7 @@ Status readInput(Format format, Input& input, Complex& out, Notes& notes,
   out = Complex{};
   Status status = isBlank(input)
                       ? inputError("file is empty")
-                      : readFormat(format, input, out, notes, options.weld);
+                      : readFormat(format, input, out, notes, options);
   if (Status readError = input.readError(); !readError.ok()) {
     status = readError;
   }

@@ -167,14 +167,20 @@ class TextScanner {
 // Floats are rounded once, directly to float32; "nan" and "inf" are accepted
 // because the encoder reports them with the offending vertex.
 bool parseFloat(std::string_view token, float& value);
+// The same rounded to double, for float64 coordinates (ReadOptions::keepDoubles).
+bool parseDouble(std::string_view token, double& value);
 bool parseInteger(std::string_view token, int64_t& value);
 bool parseCount(std::string_view token, uint64_t& value);
 
 // Reads "x y z" from the rest of the current line onto `positions`. Returns
 // in `extraColumns` whether more tokens follow (w, colours, normals), which
-// the callers ignore with a note.
+// the callers ignore with a note. With `exact`, also appends each
+// coordinate's double there. With `beyondFloat`, sets it when a coordinate
+// says more than float32 holds (its double differs from the double of the
+// shortest decimal of its float32 rounding: "0.1" is a float32 coordinate).
 Status readPositionLine(TextScanner& scanner, std::vector<float>& positions,
-                        bool& extraColumns);
+                        bool& extraColumns, std::vector<double>* exact = nullptr,
+                        bool* beyondFloat = nullptr);
 
 // `what` for an error message: the token in quotes, shortened if long.
 std::string quoted(std::string_view token);
@@ -239,15 +245,18 @@ void addCountNote(Notes& notes, std::string_view before, uint64_t count,
 // ---------------------------------------------------------------------------
 
 // Appends space-separated fields and line ends to a byte buffer. Floats use
-// the shortest decimal form that reads back to the same float32 bits.
+// the shortest decimal form that reads back to the same float32 bits,
+// doubles the same for float64 bits (at most 17 significant digits).
 class TextOut {
  public:
   explicit TextOut(std::vector<uint8_t>& out) : out_(out) {}
 
   TextOut& word(std::string_view text);
   TextOut& real(float value);
-  // The three coordinates at `xyz`.
-  TextOut& point(const float* xyz) { return real(xyz[0]).real(xyz[1]).real(xyz[2]); }
+  TextOut& real(double value);
+  // The coordinates of `vertex`: its doubles when the complex has
+  // positions64, else its floats.
+  TextOut& point(const Complex& complex, size_t vertex);
   TextOut& integer(uint64_t value);
   TextOut& signedInteger(int64_t value);
   // One attribute value of `type`, from its bytes in memory order.
@@ -268,19 +277,24 @@ class TextOut {
 // Readers append to an empty `out`; readMemory clears it again on error.
 // PLY streams a binary body from a file; its header may run past the first
 // block of the input.
-Status readPly(Input& input, Complex& out, Notes& notes);
+// With `keepDoubles` (ReadOptions), the PLY, OBJ and Medit readers also
+// fill out.positions64 when the file holds coordinates float32 does not
+// (double properties, MeshVersionFormatted 2, OBJ decimals beyond float32),
+// positions then being their float32 roundings; without, a note says they
+// were rounded.
+Status readPly(Input& input, Complex& out, Notes& notes, bool keepDoubles);
 // The first line of a PLY or legacy VTK file, checked on the file's first
 // bytes before the rest is read: a file of another kind is refused without
 // reading all of it.
 Status checkPlySignature(const uint8_t* head, size_t size);
 Status checkVtkSignature(const uint8_t* head, size_t size);
-Status readObj(const uint8_t* data, size_t size, Complex& out, Notes& notes);
+Status readObj(const uint8_t* data, size_t size, Complex& out, Notes& notes, bool keepDoubles);
 Status readOff(const uint8_t* data, size_t size, Complex& out, Notes& notes);
 Status readXyz(const uint8_t* data, size_t size, Complex& out, Notes& notes);
 // STL streams a binary file, and welds as it reads when `weld` is set, so
 // that a soup takes memory for its distinct vertices only.
 Status readStl(Input& input, Complex& out, Notes& notes, bool weld);
-Status readMedit(const uint8_t* data, size_t size, Complex& out, Notes& notes);
+Status readMedit(const uint8_t* data, size_t size, Complex& out, Notes& notes, bool keepDoubles);
 Status readVtk(const uint8_t* data, size_t size, Complex& out, Notes& notes);
 // A TetGen .node file; `firstIndex` receives the number of its first point
 // (0 or 1), which the .ele file counts from too.

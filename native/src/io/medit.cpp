@@ -101,10 +101,11 @@ size_t arity(Kind kind) {
 
 class MeditReader {
  public:
-  MeditReader(const uint8_t* data, size_t size, Complex& out)
+  MeditReader(const uint8_t* data, size_t size, Complex& out, bool keepDoubles)
       : scanner_(data, size, {/*commaSeparates=*/false,
                               /*hashComments=*/true}),
-        out_(out) {}
+        out_(out),
+        keepDoubles_(keepDoubles) {}
 
   Status read(Notes& notes) {
     std::string_view keyword;
@@ -133,10 +134,10 @@ class MeditReader {
       notes.push_back("ignored what follows End (from line " +
                       std::to_string(scanner_.lineNumber()) + ")");
     }
-    if (doublePrecision_) {
+    if (doublePrecision_ && !keepDoubles_) {
       notes.push_back(
           "coordinates of MeshVersionFormatted 2 (double precision) were "
-          "rounded to float32");
+          "rounded to float32 (exact encoding keeps them)");
     }
     split_.addNote(notes);
     keepLabels(notes);
@@ -226,6 +227,8 @@ class MeditReader {
     }
     out_.positions.reserve(3 * count);
     vertexReferences_.reserve(count);
+    // Double precision files keep their doubles too when asked to.
+    const bool doubles = doublePrecision_ && keepDoubles_;
     for (uint64_t v = 0; v < count; ++v) {
       float xyz[3];
       for (float& value : xyz) {
@@ -233,9 +236,14 @@ class MeditReader {
         if (Status status = nextValue(Kind::Vertices, v, token); !status.ok()) {
           return status;
         }
-        if (!parseFloat(token, value)) {
+        double exact = 0;
+        if (doubles ? !parseDouble(token, exact) : !parseFloat(token, value)) {
           return error("vertex " + std::to_string(v) + ": " + quoted(token) +
                        " is not a number");
+        }
+        if (doubles) {
+          value = static_cast<float>(exact);
+          out_.positions64.push_back(exact);
         }
       }
       int64_t reference = 0;
@@ -403,6 +411,7 @@ class MeditReader {
 
   TextScanner scanner_;
   Complex& out_;
+  const bool keepDoubles_;
   bool sawVersion_ = false;
   bool sawVertices_ = false;
   bool doublePrecision_ = false;
@@ -416,8 +425,8 @@ class MeditReader {
 }  // namespace
 
 Status readMedit(const uint8_t* data, size_t size, Complex& out,
-                 Notes& notes) {
-  return MeditReader(data, size, out).read(notes);
+                 Notes& notes, bool keepDoubles) {
+  return MeditReader(data, size, out, keepDoubles).read(notes);
 }
 
 bool meditHoldsAttribute(const VertexAttribute& a) {
@@ -431,14 +440,14 @@ Status writeMedit(const Complex& complex, std::vector<uint8_t>& out) {
                          "simplices use");
   }
   TextOut text(out);
-  text.word("MeshVersionFormatted 1").endLine();
+  // Version 2 declares double precision, for positions64.
+  text.word(complex.positions64.empty() ? "MeshVersionFormatted 1" : "MeshVersionFormatted 2").endLine();
   text.word("Dimension 3").endLine();
   text.word("Vertices").endLine();
   text.integer(complex.vertexCount()).endLine();
-  const std::vector<float>& positions = complex.positions;
   const VertexAttribute* references = findAttribute(complex, "ref");
   for (size_t v = 0; v < complex.vertexCount(); ++v) {
-    text.point(&positions[3 * v]);
+    text.point(complex, v);
     if (references) {
       text.value(references->type, &references->values[v * references->valueBytes()]);
     } else {

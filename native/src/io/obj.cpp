@@ -3,6 +3,7 @@
 // attributes `uv` and `normal`. Materials, groups and objects are not part
 // of a simplicial complex: their lines are counted in a note.
 #include <cstring>
+#include <type_traits>
 #include <unordered_map>
 #include <unordered_set>
 
@@ -211,17 +212,23 @@ void makeCornerVertices(const Definitions& defined, const CornerVertices& corner
   };
   for (const auto* list : {&out.points, &out.edges, &out.triangles}) markBare(*list);
   std::vector<uint32_t> vertexOf(positions, kNone);
-  std::vector<float> xyz;
   size_t count = 0;
   for (size_t v = 0; v < positions; ++v)
     if (bare[v]) vertexOf[v] = uint32_t(count++);
   const size_t firstCorner = count;
   count += corners.keys.size();
-  xyz.reserve(count * 3);
-  for (size_t v = 0; v < positions; ++v)
-    if (bare[v]) xyz.insert(xyz.end(), &out.positions[3 * v], &out.positions[3 * v] + 3);
-  for (const CornerVertices::Key& k : corners.keys) xyz.insert(xyz.end(), &out.positions[3 * k.v], &out.positions[3 * k.v] + 3);
-  out.positions.swap(xyz);
+  // The bare positions, then each corner's copy (doubles alike).
+  auto reorder = [&](auto& values) {
+    std::remove_reference_t<decltype(values)> reordered;
+    reordered.reserve(count * 3);
+    for (size_t v = 0; v < positions; ++v)
+      if (bare[v]) reordered.insert(reordered.end(), &values[3 * v], &values[3 * v] + 3);
+    for (const CornerVertices::Key& k : corners.keys)
+      reordered.insert(reordered.end(), &values[3 * size_t(k.v)], &values[3 * size_t(k.v)] + 3);
+    values.swap(reordered);
+  };
+  reorder(out.positions);
+  if (!out.positions64.empty()) reorder(out.positions64);
 
   VertexAttribute uv = floatAttribute("uv", defined.uvComponents, count);
   VertexAttribute normal = floatAttribute("normal", 3, count);
@@ -247,7 +254,7 @@ void makeCornerVertices(const Definitions& defined, const CornerVertices& corner
 
 }  // namespace
 
-Status readObj(const uint8_t* data, size_t size, Complex& out, Notes& notes) {
+Status readObj(const uint8_t* data, size_t size, Complex& out, Notes& notes, bool keepDoubles) {
   TextScanner scanner(data, size, {/*commaSeparates=*/false,
                                    /*hashComments=*/true});
   std::vector<uint32_t> indices;  // of one line, reused
@@ -258,6 +265,7 @@ Status readObj(const uint8_t* data, size_t size, Complex& out, Notes& notes) {
   size_t unknownLines = 0;
   size_t skipped[kSkippedKinds] = {};
   std::string firstUnknown;
+  bool beyondFloat = false;  // a coordinate that float32 does not hold
   std::string_view keyword;
   while (scanner.nextLine()) {
     if (!scanner.nextToken(keyword)) continue;
@@ -265,7 +273,8 @@ Status readObj(const uint8_t* data, size_t size, Complex& out, Notes& notes) {
       if (out.vertexCount() >= kCornerBit - 1)
         return lineError(scanner.lineNumber(), "more than 2^31 - 1 vertices");
       bool extraColumns = false;
-      Status status = readPositionLine(scanner, out.positions, extraColumns);
+      Status status = readPositionLine(scanner, out.positions, extraColumns,
+                                       keepDoubles ? &out.positions64 : nullptr, &beyondFloat);
       if (!status.ok()) return status;
       extraColumnLines += extraColumns;
     } else if (keyword == "vt" || keyword == "vn") {
@@ -287,6 +296,14 @@ Status readObj(const uint8_t* data, size_t size, Complex& out, Notes& notes) {
       }
     }
   }
+  // Doubles only when some coordinate needs them: a float32 file stays one.
+  if (beyondFloat && keepDoubles) {
+    for (size_t i = 0; i < out.positions.size(); ++i) out.positions[i] = static_cast<float>(out.positions64[i]);
+  } else {
+    out.positions64.clear();
+  }
+  if (beyondFloat && !keepDoubles)
+    notes.push_back("coordinates with more digits than float32 holds were rounded to float32 (exact encoding keeps them)");
   if (!corners.keys.empty() || defined.uvCount() > 0 || defined.normalCount() > 0)
     makeCornerVertices(defined, corners, out, notes);
   addCountNote(notes, "ignored extra columns (w or colour) on ", extraColumnLines, "vertex line", "vertex lines");
@@ -353,8 +370,10 @@ Status writeObj(const Complex& complex, std::vector<uint8_t>& out) {
     // Identical positions, texture coordinates and normals are written
     // once; a vertex whose whole corner equals another's gets a v line of
     // its own, so that reading the file back gives every vertex again.
-    const std::vector<uint32_t> samePosition = distinctRecords(
-        reinterpret_cast<const uint8_t*>(complex.positions.data()), n, 12, positionLines);
+    const std::vector<uint32_t> samePosition =
+        complex.positions64.empty()
+            ? distinctRecords(reinterpret_cast<const uint8_t*>(complex.positions.data()), n, 12, positionLines)
+            : distinctRecords(reinterpret_cast<const uint8_t*>(complex.positions64.data()), n, 24, positionLines);
     if (uv) uvOf = distinctRecords(uv->values.data(), n, uv->valueBytes(), uvLines);
     if (normal) normalOf = distinctRecords(normal->values.data(), n, 12, normalLines);
     struct Corner {
@@ -379,7 +398,7 @@ Status writeObj(const Complex& complex, std::vector<uint8_t>& out) {
       position[v] = c.position;
     }
   }
-  for (const uint32_t v : positionLines) text.word("v").point(&complex.positions[3 * size_t(v)]).endLine();
+  for (const uint32_t v : positionLines) text.word("v").point(complex, v).endLine();
   for (const uint32_t v : uvLines) {
     text.word("vt");
     for (size_t k = 0; k < uv->components; ++k) {
@@ -392,7 +411,7 @@ Status writeObj(const Complex& complex, std::vector<uint8_t>& out) {
   for (const uint32_t v : normalLines) {
     float xyz[3];
     std::memcpy(xyz, &normal->values[size_t(v) * 12], 12);
-    text.word("vn").point(xyz).endLine();
+    text.word("vn").real(xyz[0]).real(xyz[1]).real(xyz[2]).endLine();
   }
   // OBJ indices count from 1; v/vt/vn, or v//vn without texture coordinates.
   std::string corner;

@@ -185,10 +185,7 @@ Status writeOff(const Complex& complex, std::vector<uint8_t>& out) {
       .integer(complex.triangles.size() / 3)
       .integer(0)
       .endLine();
-  const std::vector<float>& positions = complex.positions;
-  for (size_t i = 0; i < positions.size(); i += 3) {
-    text.point(&positions[i]).endLine();
-  }
+  for (size_t v = 0; v < complex.vertexCount(); ++v) text.point(complex, v).endLine();
   for (size_t i = 0; i < complex.triangles.size(); i += 3) {
     text.integer(3);
     for (size_t k = 0; k < 3; ++k) text.integer(complex.triangles[i + k]);

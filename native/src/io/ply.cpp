@@ -478,12 +478,15 @@ class AsciiValues {
  public:
   explicit AsciiValues(TextScanner& scanner) : scanner_(scanner) {}
 
-  bool coordinate(Scalar, float& value) {
+  // A coordinate as float32, and as a double into `exact` when given (then
+  // `value` is its rounding).
+  bool coordinate(Scalar, float& value, double* exact = nullptr) {
     std::string_view token;
     if (!next(token)) return false;
-    if (!parseFloat(token, value)) {
+    if (exact ? !parseDouble(token, *exact) : !parseFloat(token, value)) {
       return fail(quoted(token) + " is not a number");
     }
+    if (exact) value = static_cast<float>(*exact);
     return true;
   }
   bool integer(Scalar, int64_t& value) {
@@ -549,13 +552,15 @@ class BinaryValues {
   BinaryValues(ByteStream& bytes, bool bigEndian)
       : bytes_(bytes), bigEndian_(bigEndian) {}
 
-  bool coordinate(Scalar type, float& value) {
+  // A coordinate as float32, and as a double into `exact` when given.
+  bool coordinate(Scalar type, float& value, double* exact = nullptr) {
     const uint8_t* bytes = take(type);
     if (bytes == nullptr) return false;
-    // float32 goes straight through so that even NaN payloads keep their bits.
-    value = type == Scalar::Float32
-                ? loadScalar<float>(bytes, bigEndian_)
-                : static_cast<float>(loadAsDouble(type, bytes, bigEndian_));
+    // float32 goes straight through so that even NaN payloads keep their
+    // bits; a double is rounded once.
+    const double wide = loadAsDouble(type, bytes, bigEndian_);
+    value = type == Scalar::Float32 ? loadScalar<float>(bytes, bigEndian_) : static_cast<float>(wide);
+    if (exact) *exact = wide;
     return true;
   }
   // Only called for integer types, which double holds exactly.
@@ -617,6 +622,7 @@ class BinaryValues {
 struct BodyState {
   Complex& out;
   uint64_t vertexCount;
+  bool doubles;  // coordinates kept as doubles too, in out.positions64
   std::vector<uint32_t> polygon;  // reused for every list
   PolygonSplit split;
 };
@@ -719,6 +725,7 @@ Status readElement(Values& values, const PlyElement& element,
   }
   for (uint64_t item = 0; item < element.count; ++item) {
     float xyz[3] = {0, 0, 0};
+    double exact[3] = {0, 0, 0};
     uint32_t pair[2] = {0, 0};
     int64_t label = 0;
     for (size_t i = 0; i < element.properties.size(); ++i) {
@@ -726,11 +733,11 @@ Status readElement(Values& values, const PlyElement& element,
       const Use use = plan.uses[i];
       bool ok = true;
       switch (use) {
-        case Use::X: case Use::Y: case Use::Z:
-          ok = values.coordinate(
-              property.type,
-              xyz[static_cast<int>(use) - static_cast<int>(Use::X)]);
+        case Use::X: case Use::Y: case Use::Z: {
+          const int axis = static_cast<int>(use) - static_cast<int>(Use::X);
+          ok = values.coordinate(property.type, xyz[axis], state.doubles ? &exact[axis] : nullptr);
           break;
+        }
         case Use::First: case Use::Second:
           ok = readIndex(values, property.type, state.vertexCount,
                          pair[use == Use::First ? 0 : 1]);
@@ -764,6 +771,7 @@ Status readElement(Values& values, const PlyElement& element,
     switch (plan.role) {
       case Role::Vertex:
         out.positions.insert(out.positions.end(), xyz, xyz + 3);
+        if (state.doubles) out.positions64.insert(out.positions64.end(), exact, exact + 3);
         for (size_t a = 0; a < vertexValues.size(); ++a) {
           std::vector<uint8_t>& values = out.attributes[a].values;
           values.insert(values.end(), vertexValues[a].data(), vertexValues[a].data() + out.attributes[a].valueBytes());
@@ -812,10 +820,11 @@ Status readBody(Values& values, const PlyHeader& header,
   return Status::success();
 }
 
+// `doubleCoordinates` tells whether a coordinate is stored as double; unless
+// `keepDoubles`, a note says they are rounded to float32.
 Status planElements(const PlyHeader& header, std::vector<ElementPlan>& plans,
-                    uint64_t& vertexCount, Notes& notes) {
+                    uint64_t& vertexCount, bool keepDoubles, bool& doubleCoordinates, Notes& notes) {
   bool haveVertices = false;
-  bool doubleCoordinates = false;
   plans.resize(header.elements.size());
   for (size_t e = 0; e < header.elements.size(); ++e) {
     const PlyElement& element = header.elements[e];
@@ -831,8 +840,8 @@ Status planElements(const PlyHeader& header, std::vector<ElementPlan>& plans,
     return inputError("PLY file declares " + std::to_string(vertexCount) +
                       " vertices, more than 32-bit indices can address");
   }
-  if (doubleCoordinates) {
-    notes.push_back("coordinates stored as double were rounded to float32");
+  if (doubleCoordinates && !keepDoubles) {
+    notes.push_back("coordinates stored as double were rounded to float32 (exact encoding keeps them)");
   }
   return Status::success();
 }
@@ -892,7 +901,7 @@ Status readBinaryBody(Input& input, uint64_t body, const PlyHeader& header,
 
 }  // namespace
 
-Status readPly(Input& input, Complex& out, Notes& notes) {
+Status readPly(Input& input, Complex& out, Notes& notes, bool keepDoubles) {
   PlyHeader header;
   uint64_t body = 0;
   if (Status status = readHeader(input, header, body); !status.ok()) {
@@ -900,13 +909,14 @@ Status readPly(Input& input, Complex& out, Notes& notes) {
   }
   std::vector<ElementPlan> plans;
   uint64_t vertexCount = 0;
-  if (Status status = planElements(header, plans, vertexCount, notes);
+  bool doubleCoordinates = false;
+  if (Status status = planElements(header, plans, vertexCount, keepDoubles, doubleCoordinates, notes);
       !status.ok()) {
     return status;
   }
   for (const ElementPlan& plan : plans)
     if (plan.role == Role::Vertex) out.attributes = plan.attributes;
-  BodyState state{out, vertexCount, {}, {}};
+  BodyState state{out, vertexCount, doubleCoordinates && keepDoubles, {}, {}};
   uint64_t trailingBytes = 0;
   uint64_t trailingValues = 0;
   Status status =
@@ -976,6 +986,7 @@ class BinarySink {
  public:
   explicit BinarySink(std::vector<uint8_t>& out) : out_(out) {}
   void coordinate(float value) { appendLittleEndian(out_, value); }
+  void coordinate(double value) { appendLittleEndian(out_, value); }
   // One attribute value, from its bytes in memory order (little-endian).
   void attribute(AttributeType type, const uint8_t* value) {
     out_.insert(out_.end(), value, value + attributeTypeBytes(type));
@@ -993,6 +1004,7 @@ class TextSink {
  public:
   explicit TextSink(std::vector<uint8_t>& out) : text_(out) {}
   void coordinate(float value) { text_.real(value); }
+  void coordinate(double value) { text_.real(value); }
   void attribute(AttributeType type, const uint8_t* value) { text_.value(type, value); }
   void listLength(uint8_t length) { text_.integer(length); }
   void index(uint32_t value) { text_.integer(value); }
@@ -1007,8 +1019,11 @@ template <class Sink>
 void writeBody(const Complex& complex,
                const std::vector<SimplexElement>& elements, Sink& sink) {
   for (size_t v = 0; v < complex.vertexCount(); ++v) {
-    for (int axis = 0; axis < 3; ++axis) {
-      sink.coordinate(complex.positions[3 * v + axis]);
+    for (size_t axis = 0; axis < 3; ++axis) {
+      if (complex.positions64.empty())
+        sink.coordinate(complex.positions[3 * v + axis]);
+      else
+        sink.coordinate(complex.positions64[3 * v + axis]);
     }
     for (const VertexAttribute& a : complex.attributes) {
       const size_t bytes = attributeTypeBytes(a.type);
@@ -1040,7 +1055,7 @@ void writeHeader(const Complex& complex,
   text.word("comment written by kdmesh").endLine();
   text.word("element vertex").integer(complex.vertexCount()).endLine();
   for (const char* axis : {"x", "y", "z"}) {
-    text.word("property float").word(axis).endLine();
+    text.word(complex.positions64.empty() ? "property float" : "property double").word(axis).endLine();
   }
   for (const VertexAttribute& a : complex.attributes)
     for (const std::string& name : propertyNames(a)) text.word("property").word(plyTypeName(a.type)).word(name).endLine();

@@ -46,6 +46,12 @@ Status readHeader(TextScanner& scanner, const char* file, size_t required,
   return Status::success();
 }
 
+// The name the reader gives the float32 attribute that holds .node point
+// attribute columns `first` on, when the file has `total` of them.
+std::string pointAttributeName(uint64_t first, uint64_t total) {
+  return total <= 4 ? "attribute" : "attribute_" + std::to_string(first);
+}
+
 // Reads the number that starts an item line and checks that it continues
 // the numbering; the first item sets the base (0 or 1).
 Status readItemNumber(TextScanner& scanner, const char* what, uint64_t item,
@@ -160,7 +166,7 @@ Status readTetgenNode(const uint8_t* data, size_t size, Complex& out,
   const uint64_t kept = std::min<uint64_t>(attributes, 4 * (kMaxAttributes - 1));
   std::vector<VertexAttribute> pointAttributes;
   for (uint64_t first = 0; first < kept; first += 4) {
-    VertexAttribute a{kept <= 4 ? "attribute" : "attribute_" + std::to_string(first), AttributeType::Float32,
+    VertexAttribute a{pointAttributeName(first, kept), AttributeType::Float32,
                       uint8_t(std::min<uint64_t>(4, kept - first)), {}, {}};
     a.values.reserve(count * a.valueBytes());
     pointAttributes.push_back(std::move(a));
@@ -344,9 +350,42 @@ Status readTetgenEle(const uint8_t* data, size_t size, uint32_t firstIndex,
   return Status::success();
 }
 
+namespace {
+
+// The attributes of `complex` that hold its .node point attribute columns,
+// in column order: `attribute` alone, or `attribute_0`, `attribute_4`, ...
+// (4 components each but the last), as readTetgenNode names them, so that
+// the file reads back with the same attributes. Fails when the complex's
+// point attributes are not such a sequence.
+Status pointAttributeColumns(const Complex& complex, std::vector<const VertexAttribute*>& columns) {
+  uint64_t total = 0;
+  for (const VertexAttribute& a : complex.attributes)
+    if (a.name != "marker") total += a.components;
+  for (uint64_t first = 0; first < total; first += 4) {
+    const VertexAttribute* a = findAttribute(complex, pointAttributeName(first, total));
+    if (!a || a->components != std::min<uint64_t>(4, total - first))
+      return Status::error(ErrorCode::InvalidArgument,
+                           "TetGen point attributes must be float32 'attribute' (1 to 4 components) or "
+                           "'attribute_0', 'attribute_4', ... of 4 components each but the last, as the "
+                           "reader names them; this complex has no " + std::to_string(std::min<uint64_t>(4, total - first)) +
+                               "-component '" + pointAttributeName(first, total) + "'");
+    columns.push_back(a);
+  }
+  return Status::success();
+}
+
+}  // namespace
+
 bool tetgenHoldsAttribute(const VertexAttribute& a) {
-  return (a.name == "attribute" && a.type == AttributeType::Float32) ||
-         (a.name == "marker" && a.components == 1 && a.type != AttributeType::Float32);
+  if (a.name == "marker") return a.components == 1 && a.type != AttributeType::Float32;
+  if (a.type != AttributeType::Float32) return false;
+  if (a.name == "attribute") return true;
+  // attribute_<first column>, the first column a multiple of 4.
+  const std::string_view prefix = "attribute_";
+  if (a.name.compare(0, prefix.size(), prefix) != 0 || a.name.size() == prefix.size()) return false;
+  int64_t first = 0;
+  return parseInteger(std::string_view(a.name).substr(prefix.size()), first) && first >= 0 && first % 4 == 0 &&
+         a.name == "attribute_" + std::to_string(first);
 }
 
 Status writeTetgenNode(const Complex& complex, std::vector<uint8_t>& out) {
@@ -361,22 +400,24 @@ Status writeTetgenNode(const Complex& complex, std::vector<uint8_t>& out) {
                          "TetGen cannot hold explicit points on vertices "
                          "that tetrahedra use");
   }
-  const VertexAttribute* values = findAttribute(complex, "attribute");
+  std::vector<const VertexAttribute*> columns;
+  if (Status status = pointAttributeColumns(complex, columns); !status.ok()) return status;
+  uint64_t columnCount = 0;
+  for (const VertexAttribute* a : columns) columnCount += a->components;
   const VertexAttribute* marker = findAttribute(complex, "marker");
   TextOut text(out);
   text.word("# written by kdmesh").endLine();
   text.integer(complex.vertexCount())
       .integer(3)
-      .integer(values ? values->components : 0)
+      .integer(columnCount)
       .integer(marker ? 1 : 0)
       .endLine();
-  const std::vector<float>& positions = complex.positions;
   for (size_t v = 0; v < complex.vertexCount(); ++v) {
     text.integer(v + 1)  // numbered from 1, as TetGen writes by default
-        .point(&positions[3 * v]);
-    if (values)
-      for (size_t k = 0; k < values->components; ++k)
-        text.value(AttributeType::Float32, &values->values[(v * values->components + k) * 4]);
+        .point(complex, v);
+    for (const VertexAttribute* a : columns)
+      for (size_t k = 0; k < a->components; ++k)
+        text.value(AttributeType::Float32, &a->values[(v * a->components + k) * 4]);
     if (marker) text.value(marker->type, &marker->values[v * marker->valueBytes()]);
     text.endLine();
   }

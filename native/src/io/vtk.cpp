@@ -860,11 +860,8 @@ Status writeVtk(const Complex& complex, std::vector<uint8_t>& out) {
   text.word("written by kdmesh").endLine();
   text.word("ASCII").endLine();
   text.word("DATASET UNSTRUCTURED_GRID").endLine();
-  text.word("POINTS").integer(complex.vertexCount()).word("float").endLine();
-  const std::vector<float>& positions = complex.positions;
-  for (size_t i = 0; i < positions.size(); i += 3) {
-    text.point(&positions[i]).endLine();
-  }
+  text.word("POINTS").integer(complex.vertexCount()).word(complex.positions64.empty() ? "float" : "double").endLine();
+  for (size_t v = 0; v < complex.vertexCount(); ++v) text.point(complex, v).endLine();
   const struct {
     const std::vector<uint32_t>& indices;
     size_t arity;

@@ -136,9 +136,10 @@ void addWeldNotes(Notes& notes, size_t before, size_t after, size_t dropped) {
 
 namespace {
 
-// With vertex attributes: vertices become one only if their positions and
-// every attribute's values are bit-identical (a seam's vertices stay
-// apart). Replaces the positions and values by the welded vertices'.
+// With vertex attributes or float64 positions: vertices become one only if
+// their positions (doubles, when there are) and every attribute's values
+// are bit-identical (a seam's vertices stay apart). Replaces the positions
+// and values by the welded vertices'.
 std::vector<uint32_t> weldVerticesAndValues(Complex& complex) {
   const size_t n = complex.vertexCount();
   // The hash is seeded at random, so that no input can make it collide on purpose.
@@ -159,6 +160,7 @@ std::vector<uint32_t> weldVerticesAndValues(Complex& complex) {
   std::string key;
   for (size_t v = 0; v < n; ++v) {
     key.assign(reinterpret_cast<const char*>(&complex.positions[3 * v]), 12);
+    if (!complex.positions64.empty()) key.append(reinterpret_cast<const char*>(&complex.positions64[3 * v]), 24);
     for (const VertexAttribute& a : complex.attributes)
       key.append(reinterpret_cast<const char*>(&a.values[v * a.valueBytes()]), a.valueBytes());
     const auto [at, inserted] = seen.emplace(key, uint32_t(kept.size()));
@@ -169,6 +171,13 @@ std::vector<uint32_t> weldVerticesAndValues(Complex& complex) {
   positions.reserve(kept.size() * 3);
   for (const uint32_t v : kept) positions.insert(positions.end(), &complex.positions[3 * v], &complex.positions[3 * v] + 3);
   complex.positions.swap(positions);
+  if (!complex.positions64.empty()) {
+    std::vector<double> doubles;
+    doubles.reserve(kept.size() * 3);
+    for (const uint32_t v : kept)
+      doubles.insert(doubles.end(), &complex.positions64[3 * v], &complex.positions64[3 * v] + 3);
+    complex.positions64.swap(doubles);
+  }
   for (VertexAttribute& a : complex.attributes) {
     std::vector<uint8_t> values;
     values.reserve(kept.size() * a.valueBytes());
@@ -185,7 +194,8 @@ void weldVertices(Complex& complex, Notes& notes) {
   const size_t n = complex.vertexCount();
   if (n < 2) return;
   const std::vector<uint32_t> newIndex =
-      complex.attributes.empty() ? weldPositions(complex.positions) : weldVerticesAndValues(complex);
+      complex.attributes.empty() && complex.positions64.empty() ? weldPositions(complex.positions)
+                                                                : weldVerticesAndValues(complex);
   if (complex.vertexCount() == n) return;
   remap(complex.points, 1, newIndex);
   const size_t dropped = remap(complex.edges, 2, newIndex) +

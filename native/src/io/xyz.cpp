@@ -26,10 +26,7 @@ Status writeXyz(const Complex& complex, std::vector<uint8_t>& out) {
                          "edges, triangles or tetrahedra");
   }
   TextOut text(out);
-  const std::vector<float>& positions = complex.positions;
-  for (size_t i = 0; i < positions.size(); i += 3) {
-    text.point(&positions[i]).endLine();
-  }
+  for (size_t v = 0; v < complex.vertexCount(); ++v) text.point(complex, v).endLine();
   return Status::success();
 }
 
