@@ -285,7 +285,13 @@ TEST(Float64Files, PlyDoublesBinaryAndAscii) {
 
 TEST(Float64Files, MeditVersion2) { expectFileRoundTrip(io::Format::Medit, doubleBlock(false, true)); }
 
-TEST(Float64Files, ObjDecimalsBeyondFloat32) { expectFileRoundTrip(io::Format::Obj, doubleBlock(false, false)); }
+TEST(Float64Files, TextDecimalsBeyondFloat32) {
+  expectFileRoundTrip(io::Format::Obj, doubleBlock(false, false));
+  expectFileRoundTrip(io::Format::Off, doubleBlock(false, false));
+  Complex cloud = doubleBlock(false, false);
+  cloud.triangles.clear();
+  expectFileRoundTrip(io::Format::Xyz, cloud);
+}
 
 TEST(Float64Files, Float32FilesStayFloat32) {
   // Shortest float32 decimals ("0.1") are float32 coordinates, and a
@@ -305,7 +311,7 @@ TEST(Float64Files, Float32FilesStayFloat32) {
   EXPECT_EQ(longer.complex.positions64[6], 0.1000000001);
   EXPECT_EQ(longer.complex.positions[6], float(0.1000000001));
   const Complex floats = sphereMesh(6, 8);
-  for (const io::Format format : {io::Format::Ply, io::Format::Medit, io::Format::Obj}) {
+  for (const io::Format format : {io::Format::Ply, io::Format::Medit, io::Format::Obj, io::Format::Off}) {
     std::vector<uint8_t> bytes;
     ASSERT_TRUE(io::writeMemory(format, floats, bytes).ok());
     const ReadResult read = readDoubles(format, bytes);

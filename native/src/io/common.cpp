@@ -216,6 +216,16 @@ Status readPositionLine(TextScanner& scanner, std::vector<float>& positions,
   return Status::success();
 }
 
+void settleDoubles(Complex& out, bool beyondFloat, bool keepDoubles, Notes& notes) {
+  if (beyondFloat && keepDoubles) {
+    for (size_t i = 0; i < out.positions.size(); ++i) out.positions[i] = static_cast<float>(out.positions64[i]);
+  } else {
+    out.positions64.clear();
+  }
+  if (beyondFloat && !keepDoubles)
+    notes.push_back("coordinates with more digits than float32 holds were rounded to float32 (exact encoding keeps them)");
+}
+
 std::string quoted(std::string_view token) {
   constexpr size_t kMaxShown = 40;
   // A file's bytes go to a terminal: anything but printable ASCII is shown

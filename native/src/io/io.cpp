@@ -134,8 +134,8 @@ Status readFormat(Format format, Input& input, Complex& out, Notes& notes,
   const Bytes all = input.whole();
   switch (format) {
     case Format::Obj: return detail::readObj(all.data, all.size, out, notes, options.keepDoubles);
-    case Format::Off: return detail::readOff(all.data, all.size, out, notes);
-    case Format::Xyz: return detail::readXyz(all.data, all.size, out, notes);
+    case Format::Off: return detail::readOff(all.data, all.size, out, notes, options.keepDoubles);
+    case Format::Xyz: return detail::readXyz(all.data, all.size, out, notes, options.keepDoubles);
     case Format::Medit:
       return detail::readMedit(all.data, all.size, out, notes, options.keepDoubles);
     case Format::Vtk: return detail::readVtk(all.data, all.size, out, notes);

@@ -181,6 +181,11 @@ bool parseCount(std::string_view token, uint64_t& value);
 Status readPositionLine(TextScanner& scanner, std::vector<float>& positions,
                         bool& extraColumns, std::vector<double>* exact = nullptr,
                         bool* beyondFloat = nullptr);
+// After a text reader's last position line (read with `exact` =
+// &out.positions64 when keeping doubles): keeps the doubles only when some
+// coordinate needs them, so that a float32 file stays one, with positions
+// their float32 roundings; without `keepDoubles`, notes the rounding.
+void settleDoubles(Complex& out, bool beyondFloat, bool keepDoubles, Notes& notes);
 
 // `what` for an error message: the token in quotes, shortened if long.
 std::string quoted(std::string_view token);
@@ -277,9 +282,9 @@ class TextOut {
 // Readers append to an empty `out`; readMemory clears it again on error.
 // PLY streams a binary body from a file; its header may run past the first
 // block of the input.
-// With `keepDoubles` (ReadOptions), the PLY, OBJ and Medit readers also
-// fill out.positions64 when the file holds coordinates float32 does not
-// (double properties, MeshVersionFormatted 2, OBJ decimals beyond float32),
+// With `keepDoubles` (ReadOptions), the PLY, OBJ, OFF, XYZ and Medit readers
+// also fill out.positions64 when the file holds coordinates float32 does not
+// (double properties, MeshVersionFormatted 2, decimals beyond float32),
 // positions then being their float32 roundings; without, a note says they
 // were rounded.
 Status readPly(Input& input, Complex& out, Notes& notes, bool keepDoubles);
@@ -289,8 +294,8 @@ Status readPly(Input& input, Complex& out, Notes& notes, bool keepDoubles);
 Status checkPlySignature(const uint8_t* head, size_t size);
 Status checkVtkSignature(const uint8_t* head, size_t size);
 Status readObj(const uint8_t* data, size_t size, Complex& out, Notes& notes, bool keepDoubles);
-Status readOff(const uint8_t* data, size_t size, Complex& out, Notes& notes);
-Status readXyz(const uint8_t* data, size_t size, Complex& out, Notes& notes);
+Status readOff(const uint8_t* data, size_t size, Complex& out, Notes& notes, bool keepDoubles);
+Status readXyz(const uint8_t* data, size_t size, Complex& out, Notes& notes, bool keepDoubles);
 // STL streams a binary file, and welds as it reads when `weld` is set, so
 // that a soup takes memory for its distinct vertices only.
 Status readStl(Input& input, Complex& out, Notes& notes, bool weld);

@@ -296,14 +296,7 @@ Status readObj(const uint8_t* data, size_t size, Complex& out, Notes& notes, boo
       }
     }
   }
-  // Doubles only when some coordinate needs them: a float32 file stays one.
-  if (beyondFloat && keepDoubles) {
-    for (size_t i = 0; i < out.positions.size(); ++i) out.positions[i] = static_cast<float>(out.positions64[i]);
-  } else {
-    out.positions64.clear();
-  }
-  if (beyondFloat && !keepDoubles)
-    notes.push_back("coordinates with more digits than float32 holds were rounded to float32 (exact encoding keeps them)");
+  settleDoubles(out, beyondFloat, keepDoubles, notes);
   if (!corners.keys.empty() || defined.uvCount() > 0 || defined.normalCount() > 0)
     makeCornerVertices(defined, corners, out, notes);
   addCountNote(notes, "ignored extra columns (w or colour) on ", extraColumnLines, "vertex line", "vertex lines");

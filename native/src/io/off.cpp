@@ -111,7 +111,7 @@ Status readFace(TextScanner& scanner, uint64_t face, uint64_t vertexCount,
 
 }  // namespace
 
-Status readOff(const uint8_t* data, size_t size, Complex& out, Notes& notes) {
+Status readOff(const uint8_t* data, size_t size, Complex& out, Notes& notes, bool keepDoubles) {
   TextScanner scanner(data, size, {/*commaSeparates=*/false,
                                    /*hashComments=*/true});
   uint64_t vertexCount = 0, faceCount = 0;
@@ -123,15 +123,18 @@ Status readOff(const uint8_t* data, size_t size, Complex& out, Notes& notes) {
   out.triangles.reserve(3 * faceCount);
 
   size_t extraVertexColumns = 0;
+  bool beyondFloat = false;  // a coordinate that float32 does not hold
   for (uint64_t v = 0; v < vertexCount; ++v) {
     if (!scanner.nextContentLine()) {
       return endsEarly(scanner.lineNumber(), v, vertexCount, "vertex", "vertices");
     }
     bool extraColumns = false;
-    Status status = readPositionLine(scanner, out.positions, extraColumns);
+    Status status = readPositionLine(scanner, out.positions, extraColumns,
+                                     keepDoubles ? &out.positions64 : nullptr, &beyondFloat);
     if (!status.ok()) return status;
     extraVertexColumns += extraColumns;
   }
+  settleDoubles(out, beyondFloat, keepDoubles, notes);
 
   std::vector<uint32_t> polygon;  // reused for every face
   PolygonSplit split;

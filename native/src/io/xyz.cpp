@@ -4,16 +4,19 @@
 
 namespace kdmesh::io::detail {
 
-Status readXyz(const uint8_t* data, size_t size, Complex& out, Notes& notes) {
+Status readXyz(const uint8_t* data, size_t size, Complex& out, Notes& notes, bool keepDoubles) {
   TextScanner scanner(data, size, {/*commaSeparates=*/true,
                                    /*hashComments=*/true});
   size_t extraColumnLines = 0;
+  bool beyondFloat = false;  // a coordinate that float32 does not hold
   while (scanner.nextContentLine()) {
     bool extraColumns = false;
-    Status status = readPositionLine(scanner, out.positions, extraColumns);
+    Status status = readPositionLine(scanner, out.positions, extraColumns,
+                                     keepDoubles ? &out.positions64 : nullptr, &beyondFloat);
     if (!status.ok()) return status;
     extraColumnLines += extraColumns;
   }
+  settleDoubles(out, beyondFloat, keepDoubles, notes);
   addCountNote(notes, "ignored extra columns on ", extraColumnLines,
                "line", "lines");
   return Status::success();
