@@ -130,6 +130,12 @@ function loadModule() {
   return modulePromise;
 }
 
+// Bytes handed to the WebAssembly decoder per call. Engines switch a
+// WebAssembly function to its optimized code between calls, not while it
+// runs, so a whole stream decoded in one call would run its first decode
+// in the baseline compiler's code from start to end.
+const PUSH_SLICE_BYTES = 16384;
+
 const EMPTY_INDICES = new Uint32Array(0);
 // Typed arrays of kdmesh::AttributeType's values, in its order.
 const ATTRIBUTE_ARRAYS = [Uint8Array, Int8Array, Uint16Array, Int16Array, Uint32Array, Int32Array, Float32Array];
@@ -215,9 +221,14 @@ export class Decoder {
   push(bytes) {
     const m = this.#live();
     const view = bytesOf(bytes);
-    const at = m._kdm_input(this.#handle, view.length);
-    m.HEAPU8.set(view, at);
-    this.#check(m._kdm_push(this.#handle, view.length));
+    let start = 0;
+    do {
+      const slice = view.subarray(start, start + PUSH_SLICE_BYTES);
+      const at = m._kdm_input(this.#handle, slice.length);
+      m.HEAPU8.set(slice, at);
+      this.#check(m._kdm_push(this.#handle, slice.length));
+      start += slice.length;
+    } while (start < view.length);
     return this.progress;
   }
 
