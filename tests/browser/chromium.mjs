@@ -1,6 +1,7 @@
 // Headless chromium as the browser tests and benchmarks run it: Debian's
 // build, WebGL through SwiftShader, no background traffic.
 import { chromium } from 'playwright-core';
+import { startServer } from '../../web/server.mjs';
 
 export function launchChromium() {
   return chromium.launch({
@@ -21,4 +22,21 @@ export async function openTestPage(browser, base, name, html) {
   await page.goto(`${base}/${name}`);
   await page.waitForFunction(() => window.ready);
   return { page, errors };
+}
+
+// The dev server on a free local port serving `root` (a test's models), and
+// a browser: { base, browser, close() }, close() ending both.
+export async function serveAndLaunch(root) {
+  const server = await startServer({ port: 0, root, host: '127.0.0.1' });
+  try {
+    const browser = await launchChromium();
+    const close = async () => {
+      await browser.close();
+      server.close();
+    };
+    return { base: `http://127.0.0.1:${server.address().port}`, browser, close };
+  } catch (error) {
+    server.close();
+    throw error;
+  }
 }

@@ -8,15 +8,14 @@ import { execFileSync } from 'node:child_process';
 import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { launchChromium, openTestPage } from './chromium.mjs';
+import { serveAndLaunch, openTestPage } from './chromium.mjs';
 import { decode } from 'kdmesh';
-import { startServer } from '../../web/server.mjs';
 import { modelChecksum } from '../../web/model-checksum.js';
 import { cli } from '../js/fixtures.mjs';
 import { writeTestScene, readGlb } from '../js/gltf-fixtures.mjs';
 
 const models = mkdtempSync(join(tmpdir(), 'kdmesh-gltf-'));
-let server, browser, base, expected;
+let session, browser, base, expected;
 
 const testPage = `<!doctype html><meta charset="utf-8"><link rel="icon" href="data:,">
 <script type="importmap">{ "imports": { "three": "./vendor/three/build/three.module.js",
@@ -58,14 +57,12 @@ before(async () => {
   const view = json.bufferViews[json.meshes[0].primitives[0].extensions.KDMESH_progressive_compression.bufferView];
   const decoded = await decode(bin.subarray(view.byteOffset, view.byteOffset + view.byteLength));
   expected = modelChecksum({ ...decoded, points: new Uint32Array(0) });
-  server = await startServer({ port: 0, root: models, host: '127.0.0.1' });
-  base = `http://127.0.0.1:${server.address().port}`;
-  browser = await launchChromium();
+  session = await serveAndLaunch(models);
+  ({ base, browser } = session);
 });
 
 after(async () => {
-  await browser?.close();
-  server?.close();
+  await session?.close();
   rmSync(models, { recursive: true, force: true });
 });
 

@@ -9,14 +9,13 @@ import { execFileSync } from 'node:child_process';
 import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { launchChromium, openTestPage } from './chromium.mjs';
+import { serveAndLaunch, openTestPage } from './chromium.mjs';
 import { decode } from 'kdmesh';
-import { startServer } from '../../web/server.mjs';
 import { modelChecksum } from '../../web/model-checksum.js';
 import { root, cli, colouredTorus, writePly } from '../js/fixtures.mjs';
 
 const models = mkdtempSync(join(tmpdir(), 'kdmesh-loader-'));
-let server, browser, base, expected, coloured;
+let session, browser, base, expected, coloured;
 
 // A page with three.js and kdmesh/three in its import map, as the viewer has.
 const testPage = `<!doctype html><meta charset="utf-8"><link rel="icon" href="data:,">
@@ -37,14 +36,12 @@ before(async () => {
   writePly(join(models, 'coloured.ply'), colouredTorus());
   execFileSync(cli, ['encode', join(models, 'coloured.ply'), '-o', join(models, 'coloured.kdm'), '--bits', '12', '--chunk-bytes', '1024', '-q']);
   coloured = await decode(readFileSync(join(models, 'coloured.kdm')));
-  server = await startServer({ port: 0, root: models, host: '127.0.0.1' });
-  base = `http://127.0.0.1:${server.address().port}`;
-  browser = await launchChromium();
+  session = await serveAndLaunch(models);
+  ({ base, browser } = session);
 });
 
 after(async () => {
-  await browser?.close();
-  server?.close();
+  await session?.close();
   rmSync(models, { recursive: true, force: true });
 });
 

@@ -6,16 +6,15 @@ import { execFileSync } from 'node:child_process';
 import { mkdtempSync, readFileSync, rmSync, writeFileSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { join } from 'node:path';
-import { launchChromium } from './chromium.mjs';
+import { serveAndLaunch } from './chromium.mjs';
 import { decode } from 'kdmesh';
-import { startServer } from '../../web/server.mjs';
 import { modelChecksum } from '../../web/model-checksum.js';
 import { root, cli, colouredTorus, labelledTorus, writeLabelledPly, writePly } from '../js/fixtures.mjs';
 import { writeTestScene } from '../js/gltf-fixtures.mjs';
 
 const models = mkdtempSync(join(tmpdir(), 'kdmesh-browser-'));
 const screenshots = join(root, 'build', 'screenshots');
-let server, browser, base;
+let session, browser, base;
 
 before(async () => {
   execFileSync(cli, ['encode', join(root, 'build', 'models', 'dragon_vrip.ply'), '-o', join(models, 'dragon.kdm'), '--bits', '12', '-q']);
@@ -40,14 +39,12 @@ before(async () => {
   writeTestScene(join(models, 'input-scene.glb'));
   execFileSync(cli, ['encode', join(models, 'input-scene.glb'), '-o', join(models, 'scene.kdm.glb'), '-q']);
   execFileSync('mkdir', ['-p', screenshots]);
-  server = await startServer({ port: 0, root: models, host: '127.0.0.1' });
-  base = `http://127.0.0.1:${server.address().port}`;
-  browser = await launchChromium();
+  session = await serveAndLaunch(models);
+  ({ base, browser } = session);
 });
 
 after(async () => {
-  await browser?.close();
-  server?.close();
+  await session?.close();
   rmSync(models, { recursive: true, force: true });
 });
 
