@@ -279,22 +279,19 @@ PositionPredictor::Features PositionPredictor::features(const Neighbourhood& aro
   return f;
 }
 
-uint32_t PositionPredictor::across(uint32_t slot, uint32_t a, uint32_t b) {
-  uint32_t found = acrossSlots_[slot];
-  if (found == kUnknown) {
-    // In the triangle b a c, wound that way, c follows a and b follows c.
-    found = kNowhere;
-    uint32_t walked = 0;
-    store_.forEachIncident(2, a, [&](uint32_t triangle, uint32_t position) {
-      if (++walked > kMaxAcrossWalk) return true;
-      const uint32_t row = position + (store_.flags(2, triangle) & SimplexStore::kFlipped ? 3 : 0);
-      if (store_.vertices(2, triangle)[kAfterNext[row]] != b) return false;
-      found = triangle * 3 + kNext[row];
-      return true;
-    });
-    acrossSlots_[slot] = found;
-  }
-  return found == kNowhere ? kNoSimplex : store_.vertexInSlot(2, found);
+uint32_t PositionPredictor::searchAcross(uint32_t slot, uint32_t a, uint32_t b) {
+  // In the triangle b a c, wound that way, c follows a and b follows c.
+  uint32_t found = kNowhere;
+  uint32_t walked = 0;
+  store_.forEachIncident(2, a, [&](uint32_t triangle, uint32_t position) {
+    if (++walked > kMaxAcrossWalk) return true;
+    const uint32_t row = position + (store_.flags(2, triangle) & SimplexStore::kFlipped ? 3 : 0);
+    if (store_.vertices(2, triangle)[kAfterNext[row]] != b) return false;
+    found = triangle * 3 + kNext[row];
+    return true;
+  });
+  acrossSlots_[slot] = found;
+  return found;
 }
 
 void PositionPredictor::forgetAcross(uint32_t triangle, uint32_t position) {
@@ -318,18 +315,27 @@ bool PositionPredictor::gather(uint32_t vertex, int level, Neighbourhood& around
   const double atX = at[0], atY = at[1], atZ = at[2], atAxis = at[axis];
   double sumX = 0, sumY = 0, sumZ = 0, normalX = 0, normalY = 0, normalZ = 0, squared = 0, along = 0;
   uint32_t count = 0, parallelograms = 0;
-  // Room for every triangle slot across() may be asked about.
+  // Room for every triangle slot the walk may look up.
   if (acrossSlots_.size() < size_t(store_.size(2)) * 3) acrossSlots_.resize(size_t(store_.size(2)) * 3, kUnknown);
+  // The walk reads the arrays through local pointers, which stay in
+  // registers (through the vectors, each store in the loop made the
+  // compiler load them again).
+  const SimplexStore::Lists triangles = store_.lists(2);
+  const Place* places = places_.data();
+  const uint32_t* acrossSlots = acrossSlots_.data();
   double* predictions = predictions_.data();
+  uint32_t room = uint32_t(predictions_.size());
   // Each triangle adds the vertex that follows this one in its winding
   // (around a closed, consistently wound fan, every neighbour once) and the
   // cross product of the offsets of that vertex and the next.
-  store_.forEachIncident(2, vertex, [&](uint32_t triangle, uint32_t position) {
-    const uint32_t* tuple = store_.vertices(2, triangle);
-    const uint32_t row = position + (store_.flags(2, triangle) & SimplexStore::kFlipped ? 3 : 0);
+  for (uint32_t slot = triangles.heads[vertex]; slot != kNoSimplex; slot = triangles.next[slot]) {
+    const uint32_t triangle = slot / 3;
+    if (!triangles.alive(triangle)) continue;
+    const uint32_t* tuple = triangles.vertices + size_t(triangle) * 3;
+    const uint32_t row = slot - triangle * 3 + (triangles.flags[triangle] & SimplexStore::kFlipped ? 3 : 0);
     const uint32_t next = tuple[kNext[row]], afterNext = tuple[kAfterNext[row]];
-    const double* a = places_[next].centre;
-    const double* b = places_[afterNext].centre;
+    const double* a = places[next].centre;
+    const double* b = places[afterNext].centre;
     const double ax = a[0] - atX, ay = a[1] - atY, az = a[2] - atZ;
     const double bx = b[0] - atX, by = b[1] - atY, bz = b[2] - atZ;
     const double aAlong = a[axis] - atAxis;
@@ -346,14 +352,18 @@ bool PositionPredictor::gather(uint32_t vertex, int level, Neighbourhood& around
     // The parallelogram rule: on a flat, evenly sampled surface v a c b is
     // a parallelogram, c being the far vertex of the triangle across a b;
     // listed only along the split axis, where the features look.
-    if (const uint32_t far = across(triangle * 3 + position, next, afterNext); far != kNoSimplex) {
-      if (parallelograms == predictions_.size()) {
+    uint32_t farSlot = acrossSlots[slot];
+    if (farSlot == kUnknown) farSlot = searchAcross(slot, next, afterNext);
+    if (farSlot != kNowhere) {
+      if (parallelograms == room) {
         predictions_.resize(std::max<size_t>(16, 2 * predictions_.size()));
         predictions = predictions_.data();
+        room = uint32_t(predictions_.size());
       }
-      predictions[parallelograms++] = aAlong + (b[axis] - atAxis) - (places_[far].centre[axis] - atAxis);
+      const double* c = places[triangles.vertices[farSlot]].centre;
+      predictions[parallelograms++] = aAlong + (b[axis] - atAxis) - (c[axis] - atAxis);
     }
-  });
+  }
   if (count > 0) {
     double median = 0, deviation = 0;
     if (parallelograms > 0) medianAndDeviation(predictions, parallelograms, median, deviation);

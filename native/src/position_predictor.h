@@ -156,7 +156,7 @@ class PositionPredictor {
   uint32_t proxyOf(uint32_t vertex) const { return vertex < proxies_.size() ? proxies_[vertex] : kNoSimplex; }
 
   // The split of the triangle's vertex at `position` may have changed its
-  // neighbours across the two edges through that vertex: across() will
+  // neighbours across the two edges through that vertex: gather() will
   // search for them again.
   void forgetAcross(uint32_t triangle, uint32_t position);
 
@@ -249,11 +249,12 @@ class PositionPredictor {
   // a neighbour already split). Counts the predictions with a neighbour
   // split in the cell's slab.
   int refinementClass(const Neighbourhood& around, bool mirrored, bool farHalves);
-  // The vertex c of a triangle b a c across the edge a b (wound a b), or
-  // kNoSimplex; `slot` (triangle · 3 + position) names the triangle
-  // v a b whose edge it is, under which the answer is remembered.
-  uint32_t across(uint32_t slot, uint32_t a, uint32_t b);
-  // How many of a's triangles, in list order, across() examines: beyond,
+  // Searches the triangle b a c across the edge a b (wound a b) and
+  // returns the slot of its vertex c, or kNowhere; `slot` (triangle · 3 +
+  // position) names the triangle v a b whose edge it is, under which the
+  // answer is remembered in acrossSlots_.
+  uint32_t searchAcross(uint32_t slot, uint32_t a, uint32_t b);
+  // How many of a's triangles, in list order, searchAcross() examines: beyond,
   // the edge has no triangle across for the predictions. The reference
   // meshes, tetrahedral ones included, code the same bits with this bound
   // as without (64 changes the ball's); without any, the vertices around an
@@ -298,7 +299,7 @@ class PositionPredictor {
   std::vector<Place> places_;
   std::vector<uint32_t> proxies_;  // per vertex in no simplex, else kNoSimplex
   const SimplexStore& store_;
-  // Per triangle slot (see across()), the slot of the far vertex c of the
+  // Per triangle slot (see searchAcross()), the slot of the far vertex c of the
   // triangle found across the edge opposite the slot's vertex (kNowhere: no
   // triangle; kUnknown: not searched since the triangle's star changed).
   // Searching walks a's triangles; a vertex split changes the answer only

@@ -134,6 +134,23 @@ class SimplexStore {
   }
   bool hasIncident(int dimension, uint32_t vertex) const;
 
+  // One dimension's incidence lists as plain arrays, for the hottest walks:
+  // a loop over local pointers keeps them in registers, where a walk
+  // through the vectors reloads them after each of its stores. Valid until
+  // the next add() of that dimension.
+  struct Lists {
+    const uint32_t* heads;     // first slot per vertex
+    const uint32_t* next;      // next slot per slot
+    const uint32_t* vertices;  // arity per simplex
+    const uint8_t* flags;
+    bool skipDead;  // indexed stores kill simplices; their walks skip them
+    bool alive(uint32_t simplex) const { return !skipDead || (flags[simplex] & kAlive); }
+  };
+  Lists lists(int dimension) const {
+    const Pool& pool = pool_[dimension];
+    return {heads_[dimension].data(), pool.next.data(), pool.vertices.data(), pool.flags.data(), indexed_};
+  }
+
   // Empties `vertex`'s list of `dimension` without touching the simplices;
   // the caller relinks every slot it keeps with link().
   void detach(int dimension, uint32_t vertex) { heads_[dimension][vertex] = kNoSimplex; }
