@@ -218,7 +218,7 @@ TEST(Float64, HostileHeadersAndTablesAreRefused) {
 }
 
 // ---------------------------------------------------------------------------
-// Files: PLY double, Medit version 2, OBJ decimals beyond float32
+// Files: PLY double, Medit version 2, text decimals beyond float32
 // ---------------------------------------------------------------------------
 
 // Reads `bytes` keeping doubles.
@@ -288,9 +288,11 @@ TEST(Float64Files, MeditVersion2) { expectFileRoundTrip(io::Format::Medit, doubl
 TEST(Float64Files, TextDecimalsBeyondFloat32) {
   expectFileRoundTrip(io::Format::Obj, doubleBlock(false, false));
   expectFileRoundTrip(io::Format::Off, doubleBlock(false, false));
+  expectFileRoundTrip(io::Format::Vtk, doubleBlock(false, true));
   Complex cloud = doubleBlock(false, false);
   cloud.triangles.clear();
   expectFileRoundTrip(io::Format::Xyz, cloud);
+  expectFileRoundTrip(io::Format::TetGen, cloud);  // the .node file alone
 }
 
 TEST(Float64Files, Float32FilesStayFloat32) {
@@ -311,7 +313,16 @@ TEST(Float64Files, Float32FilesStayFloat32) {
   EXPECT_EQ(longer.complex.positions64[6], 0.1000000001);
   EXPECT_EQ(longer.complex.positions[6], float(0.1000000001));
   const Complex floats = sphereMesh(6, 8);
-  for (const io::Format format : {io::Format::Ply, io::Format::Medit, io::Format::Obj, io::Format::Off}) {
+  // VTK declares its POINTS double or float, but writes decimals: a double
+  // array of float32 values is a float32 file.
+  const ReadResult vtk = readDoubles(
+      io::Format::Vtk, bytesOf("# vtk DataFile Version 3.0\nt\nASCII\nDATASET POLYDATA\nPOINTS 2 double\n"
+                               "0.1 0.2 0.3 1e-45 -0 3.4028235e38\n"));
+  ASSERT_TRUE(vtk.status.ok()) << vtk.status.message;
+  EXPECT_TRUE(vtk.complex.positions64.empty());
+  EXPECT_TRUE(vtk.notes.empty()) << joined(vtk.notes);
+  for (const io::Format format : {io::Format::Ply, io::Format::Medit, io::Format::Obj, io::Format::Off,
+                                  io::Format::Vtk}) {
     std::vector<uint8_t> bytes;
     ASSERT_TRUE(io::writeMemory(format, floats, bytes).ok());
     const ReadResult read = readDoubles(format, bytes);

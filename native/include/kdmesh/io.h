@@ -50,11 +50,11 @@ struct ReadOptions {
   // memory for its distinct vertices rather than three per triangle.
   bool weld = false;
   // Keep float64 coordinates: PLY `double` properties, Medit
-  // MeshVersionFormatted 2 and OBJ, OFF and XYZ coordinates with more
-  // digits than float32 holds fill Complex::positions64 (exactly),
-  // positions holding their float32 roundings, for exact encoding. Without
-  // it they are rounded to float32, and a note says so. Other formats read
-  // float32. (Text: a coordinate says more than float32 holds when its
+  // MeshVersionFormatted 2 and OBJ, OFF, XYZ, VTK and TetGen .node
+  // coordinates with more digits than float32 holds fill
+  // Complex::positions64 (exactly), positions holding their float32
+  // roundings, for exact encoding. Without it they are rounded to float32,
+  // and a note says so. STL reads float32. (Text: a coordinate says more than float32 holds when its
   // double differs from that of the shortest decimal of its float32
   // rounding, so a file written from floats, "0.1" included, reads as
   // float32.)

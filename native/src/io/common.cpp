@@ -190,6 +190,17 @@ bool parseCount(std::string_view token, uint64_t& value) {
   return stop == end && error == std::errc();
 }
 
+bool parseCoordinate(std::string_view token, float& value, std::vector<double>* exact, bool* beyondFloat) {
+  if (!parseFloat(token, value)) return false;
+  if (exact) {
+    double precise = 0;
+    parseDouble(token, precise);
+    exact->push_back(precise);
+  }
+  if (beyondFloat && !*beyondFloat) *beyondFloat = beyondFloat32(token, value);
+  return true;
+}
+
 Status readPositionLine(TextScanner& scanner, std::vector<float>& positions,
                         bool& extraColumns, std::vector<double>* exact, bool* beyondFloat) {
   float xyz[3];
@@ -200,16 +211,10 @@ Status readPositionLine(TextScanner& scanner, std::vector<float>& positions,
                        "vertex has " + std::to_string(axis) +
                            " coordinates, needs 3");
     }
-    if (!parseFloat(token, xyz[axis])) {
+    if (!parseCoordinate(token, xyz[axis], exact, beyondFloat)) {
       return lineError(scanner.lineNumber(),
                        quoted(token) + " is not a number");
     }
-    if (exact) {
-      double value = 0;
-      parseDouble(token, value);
-      exact->push_back(value);
-    }
-    if (beyondFloat && !*beyondFloat) *beyondFloat = beyondFloat32(token, xyz[axis]);
   }
   positions.insert(positions.end(), xyz, xyz + 3);
   extraColumns = scanner.nextToken(token);

@@ -138,11 +138,11 @@ Status readFormat(Format format, Input& input, Complex& out, Notes& notes,
     case Format::Xyz: return detail::readXyz(all.data, all.size, out, notes, options.keepDoubles);
     case Format::Medit:
       return detail::readMedit(all.data, all.size, out, notes, options.keepDoubles);
-    case Format::Vtk: return detail::readVtk(all.data, all.size, out, notes);
+    case Format::Vtk: return detail::readVtk(all.data, all.size, out, notes, options.keepDoubles);
     case Format::TetGen: {  // one buffer: the .node file alone
       uint32_t firstIndex = 0;
       return detail::readTetgenNode(all.data, all.size, out, notes,
-                                    firstIndex);
+                                    firstIndex, options.keepDoubles);
     }
     default: break;
   }
@@ -235,7 +235,7 @@ Status openTetgenFile(const std::string& file, const std::string& given,
                : Status::success();
 }
 
-Status readTetgenFiles(const std::string& path, Complex& out, Notes& notes) {
+Status readTetgenFiles(const std::string& path, Complex& out, Notes& notes, bool keepDoubles) {
   const TetgenPaths paths = tetgenPaths(path);
   Input node;
   if (Status status = openTetgenFile(paths.node, path, node); !status.ok()) {
@@ -244,7 +244,7 @@ Status readTetgenFiles(const std::string& path, Complex& out, Notes& notes) {
   uint32_t firstIndex = 0;
   Bytes bytes = node.whole();
   Status status = detail::readTetgenNode(bytes.data, bytes.size, out, notes,
-                                         firstIndex);
+                                         firstIndex, keepDoubles);
   if (Status readError = node.readError(); !readError.ok()) return readError;
   if (!status.ok()) return inFile(status, paths.node, path);
 
@@ -341,7 +341,7 @@ Status readFile(const std::string& path, Complex& out, Notes& notes,
   if (format == Format::Unknown) return unknownFormat(path);
   if (format == Format::TetGen) {
     out = Complex{};
-    Status status = readTetgenFiles(path, out, notes);
+    Status status = readTetgenFiles(path, out, notes, options.keepDoubles);
     if (!status.ok()) {
       out = Complex{};
     } else if (options.weld) {

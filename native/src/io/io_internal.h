@@ -172,12 +172,16 @@ bool parseDouble(std::string_view token, double& value);
 bool parseInteger(std::string_view token, int64_t& value);
 bool parseCount(std::string_view token, uint64_t& value);
 
+// A decimal coordinate: its float32 rounding in `value`; with `exact`, its
+// double appended there; with `beyondFloat`, set when the decimal says more
+// than float32 holds (its double differs from the double of the shortest
+// decimal of its float32 rounding: "0.1" is a float32 coordinate). False if
+// the token is not a number.
+bool parseCoordinate(std::string_view token, float& value, std::vector<double>* exact, bool* beyondFloat);
 // Reads "x y z" from the rest of the current line onto `positions`. Returns
 // in `extraColumns` whether more tokens follow (w, colours, normals), which
 // the callers ignore with a note. With `exact`, also appends each
-// coordinate's double there. With `beyondFloat`, sets it when a coordinate
-// says more than float32 holds (its double differs from the double of the
-// shortest decimal of its float32 rounding: "0.1" is a float32 coordinate).
+// coordinate's double there; `beyondFloat` as parseCoordinate().
 Status readPositionLine(TextScanner& scanner, std::vector<float>& positions,
                         bool& extraColumns, std::vector<double>* exact = nullptr,
                         bool* beyondFloat = nullptr);
@@ -300,11 +304,13 @@ Status readXyz(const uint8_t* data, size_t size, Complex& out, Notes& notes, boo
 // that a soup takes memory for its distinct vertices only.
 Status readStl(Input& input, Complex& out, Notes& notes, bool weld);
 Status readMedit(const uint8_t* data, size_t size, Complex& out, Notes& notes, bool keepDoubles);
-Status readVtk(const uint8_t* data, size_t size, Complex& out, Notes& notes);
+Status readVtk(const uint8_t* data, size_t size, Complex& out, Notes& notes, bool keepDoubles);
 // A TetGen .node file; `firstIndex` receives the number of its first point
-// (0 or 1), which the .ele file counts from too.
+// (0 or 1), which the .ele file counts from too. `keepDoubles` keeps
+// coordinates written with more digits than float32 holds (as TetGen
+// writes them) in positions64.
 Status readTetgenNode(const uint8_t* data, size_t size, Complex& out,
-                      Notes& notes, uint32_t& firstIndex);
+                      Notes& notes, uint32_t& firstIndex, bool keepDoubles);
 // A TetGen .ele file whose nodes are the `out.vertexCount()` vertices already
 // read, numbered from `firstIndex`.
 Status readTetgenEle(const uint8_t* data, size_t size, uint32_t firstIndex,

@@ -124,7 +124,7 @@ Status endsEarly(const TextScanner& scanner, uint64_t read, uint64_t expected,
 }  // namespace
 
 Status readTetgenNode(const uint8_t* data, size_t size, Complex& out,
-                      Notes& notes, uint32_t& firstIndex) {
+                      Notes& notes, uint32_t& firstIndex, bool keepDoubles) {
   TextScanner scanner(data, size, {/*commaSeparates=*/false,
                                    /*hashComments=*/true});
   uint64_t header[4];  // points, dimension, attributes, markers
@@ -175,6 +175,7 @@ Status readTetgenNode(const uint8_t* data, size_t size, Complex& out,
   markerValues.reserve(markers ? count : 0);
   int64_t base = 0;
   size_t extraLines = 0;
+  bool beyondFloat = false;
   for (uint64_t p = 0; p < count; ++p) {
     if (!scanner.nextContentLine()) {
       return endsEarly(scanner, p, count, "point", "points");
@@ -191,7 +192,7 @@ Status readTetgenNode(const uint8_t* data, size_t size, Complex& out,
                          "point " + std::to_string(p) + " has " +
                              std::to_string(axis) + " coordinates, needs 3");
       }
-      if (!parseFloat(token, value)) {
+      if (!parseCoordinate(token, value, keepDoubles ? &out.positions64 : nullptr, &beyondFloat)) {
         return lineError(scanner.lineNumber(), "point " + std::to_string(p) +
                                                    ": " + quoted(token) +
                                                    " is not a number");
@@ -228,6 +229,7 @@ Status readTetgenNode(const uint8_t* data, size_t size, Complex& out,
     extraLines += scanner.nextToken(token);
   }
   firstIndex = static_cast<uint32_t>(base);
+  settleDoubles(out, beyondFloat, keepDoubles, notes);
   noteTrailingLines(scanner, ".node", count, "point", "points", notes);
   for (VertexAttribute& a : pointAttributes) out.attributes.push_back(std::move(a));
   if (markers) {

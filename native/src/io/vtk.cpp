@@ -159,8 +159,8 @@ Status readVtkSignature(TextScanner& scanner) {
 
 class VtkReader {
  public:
-  VtkReader(const uint8_t* data, size_t size, Complex& out)
-      : scanner_(data, size), tokens_(scanner_), out_(out) {}
+  VtkReader(const uint8_t* data, size_t size, Complex& out, bool keepDoubles)
+      : scanner_(data, size), tokens_(scanner_), out_(out), keepDoubles_(keepDoubles) {}
 
   Status read(Notes& notes) {
     if (Status status = readPreamble(); !status.ok()) return status;
@@ -199,6 +199,7 @@ class VtkReader {
     if (pendingCells_) {
       return inputError("VTK file has CELLS but no CELL_TYPES");
     }
+    settleDoubles(out_, beyondFloat_, keepDoubles_, notes);
     addNotes(notes);
     return Status::success();
   }
@@ -491,8 +492,6 @@ class VtkReader {
     if (Status status = checkBudget("POINTS", 3 * count); !status.ok()) {
       return status;
     }
-    doubleCoordinates_ = equalsIgnoringCase(type, "double") ||
-                         equalsIgnoringCase(type, "vtktypefloat64");
     out_.positions.reserve(3 * count);
     for (uint64_t i = 0; i < 3 * count; ++i) {
       std::string_view token;
@@ -501,7 +500,7 @@ class VtkReader {
         return error("the file ends inside point " + std::to_string(i / 3) +
                      " of " + std::to_string(count));
       }
-      if (!parseFloat(token, value)) {
+      if (!parseCoordinate(token, value, keepDoubles_ ? &out_.positions64 : nullptr, &beyondFloat_)) {
         return error("point " + std::to_string(i / 3) + ": " + quoted(token) +
                      " is not a number");
       }
@@ -791,9 +790,6 @@ class VtkReader {
   }
 
   void addNotes(Notes& notes) const {
-    if (doubleCoordinates_) {
-      notes.push_back("coordinates stored as double were rounded to float32");
-    }
     split_.addNote(notes);
     if (!skippedTypes_.empty()) {
       size_t total = skippedOthers_;
@@ -824,7 +820,10 @@ class VtkReader {
   bool polyData_ = false;
   bool havePoints_ = false;
   bool pendingCells_ = false;  // CELLS read, CELL_TYPES not yet
-  bool doubleCoordinates_ = false;
+  // Coordinates are read as decimals: a double array of float32 values
+  // stays float32, and `keepDoubles_` keeps any with more digits.
+  const bool keepDoubles_;
+  bool beyondFloat_ = false;
   Cells cells_;
   PolygonSplit split_;
   std::map<int64_t, size_t> skippedTypes_;  // at most 16 types named
@@ -843,8 +842,8 @@ Status checkVtkSignature(const uint8_t* head, size_t size) {
   return readVtkSignature(scanner);
 }
 
-Status readVtk(const uint8_t* data, size_t size, Complex& out, Notes& notes) {
-  return VtkReader(data, size, out).read(notes);
+Status readVtk(const uint8_t* data, size_t size, Complex& out, Notes& notes, bool keepDoubles) {
+  return VtkReader(data, size, out, keepDoubles).read(notes);
 }
 
 bool vtkHoldsAttribute(const VertexAttribute& a) {
