@@ -320,6 +320,29 @@ void AttributeCoder::addNormal(const uint8_t* values, double* sum) {
   for (int c = 0; c < 3; ++c) sum[c] += double(floatAt(values, c));
 }
 
+bool AttributeCoder::lowerHemisphere(const Layout& layout, const uint32_t* images) {
+  const int64_t top = layout.top;
+  const int64_t u = 2 * int64_t(std::min<uint32_t>(images[0], layout.top)) - top;
+  const int64_t v = 2 * int64_t(std::min<uint32_t>(images[1], layout.top)) - top;
+  return std::abs(u) + std::abs(v) > top;
+}
+
+// Negating z folds the diamond's triangles out onto the square's corners
+// and back: in coordinates centred on the square (u, v in -top..top, even
+// steps), (u, v) -> ((top - |v|) sign u, (top - |u|) sign v), sign 0 = +1.
+// The diamond's edge (z = 0) stays; the corners' image (top, top) and the
+// centre swap. Canonical images on the square's edges (u >= 0 on v = ±1,
+// v >= 0 on u = ±1) map to the diamond and come back to themselves.
+void AttributeCoder::mirrorOctahedral(const Layout& layout, uint32_t* images) {
+  const int64_t top = layout.top;
+  const int64_t u = 2 * int64_t(std::min<uint32_t>(images[0], layout.top)) - top;
+  const int64_t v = 2 * int64_t(std::min<uint32_t>(images[1], layout.top)) - top;
+  const int64_t mirroredU = (top - std::abs(v)) * (u >= 0 ? 1 : -1);
+  const int64_t mirroredV = (top - std::abs(u)) * (v >= 0 ? 1 : -1);
+  images[0] = uint32_t((mirroredU + top) / 2);
+  images[1] = uint32_t((mirroredV + top) / 2);
+}
+
 void AttributeCoder::octahedralImages(const Layout& layout, const double* direction, uint32_t* out) {
   encodeOctahedral(direction, layout.top, out);
 }

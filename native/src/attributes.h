@@ -113,7 +113,24 @@ class AttributeCoder {
       out.images[c] = uint32_t((sum[c] + neighbours.size() / 2) / neighbours.size());
       out.spread[c] = uint8_t(bitLength(high[c] - low[c]));
     }
-    if (layout.kind == AttributeQuantization::Octahedral) octahedralImages(layout, direction, out.images);
+    if (layout.kind == AttributeQuantization::Octahedral) {
+      octahedralImages(layout, direction, out.images);
+      // The spread as code() sees the images: in the mirror image when the
+      // prediction lies in the lower hemisphere.
+      if (lowerHemisphere(layout, out.images)) {
+        uint32_t mirroredLow[2] = {0xffffffffu, 0xffffffffu}, mirroredHigh[2] = {0, 0};
+        for (const uint32_t v : neighbours) {
+          uint32_t image[4];
+          images(layout, valuesOf(v), image);
+          mirrorOctahedral(layout, image);
+          for (int c = 0; c < 2; ++c) {
+            mirroredLow[c] = std::min(mirroredLow[c], image[c]);
+            mirroredHigh[c] = std::max(mirroredHigh[c], image[c]);
+          }
+        }
+        for (int c = 0; c < 2; ++c) out.spread[c] = uint8_t(bitLength(mirroredHigh[c] - mirroredLow[c]));
+      }
+    }
   }
 
   // Codes the values of one vertex of attribute `a` (encoder: `child`; the
@@ -121,17 +138,28 @@ class AttributeCoder {
   template <class Coder>
   void code(Coder& coder, size_t a, const Prediction& prediction, uint8_t* child) {
     const Layout& layout = layouts_[a];
-    uint32_t to[4], coded[4];
+    uint32_t to[4], coded[4], predicted[4];
     images(layout, child, to);  // the encoder's values; ignored by the decoder
+    std::copy(prediction.images, prediction.images + 4, predicted);
+    // A normal predicted in the lower hemisphere is coded in the mirror
+    // image (z negated), where the prediction lies in the diamond and its
+    // neighbourhood away from the square's edges, across which the
+    // octahedral map jumps.
+    const bool mirrored = layout.kind == AttributeQuantization::Octahedral && lowerHemisphere(layout, predicted);
+    if (mirrored) {
+      mirrorOctahedral(layout, predicted);
+      mirrorOctahedral(layout, to);
+    }
     int previousLength = 0;
     for (int c = 0; c < layout.components; ++c) {
-      const uint32_t from = prediction.images[c];
+      const uint32_t from = predicted[c];
       const size_t context = (size_t(c) * kLengthClasses + size_t(lengthClass(previousLength))) * kLengthClasses +
                              size_t(lengthClass(prediction.spread[c]));
       const uint32_t difference = codeDifference(coder, models_[layout.firstModels + context], layout.bits,
                                                  (to[c] - from) & layout.mask, previousLength);
       coded[c] = (from + difference) & layout.mask;
     }
+    if (mirrored) mirrorOctahedral(layout, coded);
     store(layout, child, coded);
   }
 
@@ -154,6 +182,11 @@ class AttributeCoder {
   static void images(const Layout& layout, const uint8_t* values, uint32_t* out);
   // The values that images stand for (clamped to the quantization's range).
   static void store(const Layout& layout, uint8_t* values, const uint32_t* images);
+  // Whether octahedral images lie outside the diamond (z < 0).
+  static bool lowerHemisphere(const Layout& layout, const uint32_t* images);
+  // Octahedral images of the mirror image (z negated): an involution on
+  // canonical images, which it keeps canonical.
+  static void mirrorOctahedral(const Layout& layout, uint32_t* images);
 
  private:
   struct Models {

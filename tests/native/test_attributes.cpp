@@ -232,6 +232,22 @@ TEST(AttributeQuantization, OctahedralImagesOfDequantizedNormalsAreFixedPoints) 
         float n[3];
         std::memcpy(n, values, 12);
         ASSERT_NEAR(double(n[0]) * n[0] + double(n[1]) * n[1] + double(n[2]) * n[2], 1.0, 1e-6);
+        // The mirror image (z negated) of a canonical image is the canonical
+        // image of the mirrored vector, and mirrors back.
+        uint32_t mirrored[2] = {image[0], image[1]};
+        AttributeCoder::mirrorOctahedral(layout, mirrored);
+        // (On the diamond's edge z is 0 but its float may be just below.)
+        if (std::fabs(n[2]) > 1e-6) {
+          ASSERT_EQ(AttributeCoder::lowerHemisphere(layout, image), n[2] < 0) << bits << " bits: " << u << ", " << v;
+        }
+        const float flipped[3] = {n[0], n[1], -n[2]};
+        uint32_t expected[2];
+        AttributeCoder::images(layout, reinterpret_cast<const uint8_t*>(flipped), expected);
+        ASSERT_TRUE(mirrored[0] == expected[0] && mirrored[1] == expected[1])
+            << bits << " bits: " << image[0] << ", " << image[1] << " -> " << mirrored[0] << ", " << mirrored[1]
+            << " (expected " << expected[0] << ", " << expected[1] << ")";
+        AttributeCoder::mirrorOctahedral(layout, mirrored);
+        ASSERT_TRUE(mirrored[0] == image[0] && mirrored[1] == image[1]) << bits << " bits: " << u << ", " << v;
       }
   }
 }
