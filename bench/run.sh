@@ -68,6 +68,12 @@ if [ "$quick" = 0 ]; then
   echo
 fi
 
+echo "## Vertex attributes: kdmesh vs Draco -cl 10, bits per vertex"
+echo
+# shellcheck disable=SC2086
+./build-bench/kdmesh_bench_attributes --bits 12 $meshes
+echo
+
 echo "## WebAssembly decoder in Node (warm medians)"
 echo
 sh scripts/build-wasm.sh >/dev/null
