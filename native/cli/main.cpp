@@ -332,10 +332,8 @@ int runDecode(const DecodeArgs& args) {
       note(args.output + ": left out the vertex attributes " + names + ", which " + formatName + " cannot hold");
   }
   const bool gltfOutput = kdmesh::gltf::isGltfPath(args.output);
-  // PLY, Medit and TetGen hold simplex labels; glTF does not.
   if (!complex.labels.empty() &&
-      (gltfOutput || (outputFormat != kdmesh::io::Format::Ply && outputFormat != kdmesh::io::Format::Medit &&
-                      outputFormat != kdmesh::io::Format::TetGen && outputFormat != kdmesh::io::Format::Unknown))) {
+      (gltfOutput || (!kdmesh::io::holdsLabels(outputFormat) && outputFormat != kdmesh::io::Format::Unknown))) {
     note(args.output + ": left out the simplex labels, which " + (gltfOutput ? std::string("glTF") : formatName) +
          " cannot hold");
     complex.labels = {};

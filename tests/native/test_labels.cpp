@@ -534,10 +534,46 @@ TEST(LabelFiles, TetgenRegionAttribute) {
   EXPECT_EQ(joined(notes).find("region"), std::string::npos) << joined(notes);
 }
 
+// OBJ materials (usemtl) label lines and faces: named materials are
+// numbered in order of first use, with a note; integer names are the labels
+// themselves, as the writer names them.
+TEST(LabelFiles, ObjMaterials) {
+  const std::string obj =
+      "mtllib scene.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\n"
+      "f 1 2 3\nusemtl red paint\nf 1 3 4 5\nl 1 5 2\nusemtl blue\nf 2 5 3\nusemtl red paint\nf 1 2 5\n";
+  io::Notes notes;
+  const Complex c = readText(io::Format::Obj, obj, notes);
+  // Faces before any usemtl are material 0; the quadrilateral is two triangles.
+  EXPECT_EQ(c.labels.triangles, (std::vector<int32_t>{0, 1, 1, 2, 1}));
+  EXPECT_EQ(c.labels.edges, (std::vector<int32_t>{1, 1}));
+  EXPECT_NE(joined(notes).find("0 (none), 1 'red paint', 2 'blue'"), std::string::npos) << joined(notes);
+  EXPECT_NE(joined(notes).find("1 material library (mtllib)"), std::string::npos) << joined(notes);
+  EXPECT_EQ(joined(notes).find("material use"), std::string::npos) << joined(notes);
+
+  const Complex integers =
+      readText(io::Format::Obj, "v 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl -7\nf 1 2 3\nusemtl 40\nl 1 2\n", notes);
+  EXPECT_EQ(integers.labels.triangles, (std::vector<int32_t>{-7}));
+  EXPECT_EQ(integers.labels.edges, (std::vector<int32_t>{40}));
+
+  Complex sphere = sphereMesh(5, 6);
+  sphere.edges = {0, 1, 1, 2};
+  labelBySlabs(sphere, 3);
+  for (int32_t& label : sphere.labels.triangles) label = label * 1000 - 5;
+  std::vector<uint8_t> bytes;
+  ASSERT_TRUE(io::writeMemory(io::Format::Obj, sphere, bytes).ok());
+  io::Notes again;
+  Complex back;
+  ASSERT_TRUE(io::readMemory(io::Format::Obj, bytes.data(), bytes.size(), back, again).ok());
+  EXPECT_TRUE(again.empty()) << joined(again);
+  EXPECT_EQ(back.triangles, sphere.triangles);
+  EXPECT_EQ(back.labels.triangles, sphere.labels.triangles);
+  EXPECT_EQ(back.labels.edges, sphere.labels.edges);
+}
+
 TEST(LabelFiles, FormatsWithoutLabelsRefuse) {
   Complex c = sphereMesh(5, 6);
   labelBySlabs(c, 2);
-  for (const io::Format format : {io::Format::Obj, io::Format::Off, io::Format::Vtk}) {
+  for (const io::Format format : {io::Format::Off, io::Format::Vtk}) {
     std::vector<uint8_t> bytes;
     const Status status = io::writeMemory(format, c, bytes);
     EXPECT_EQ(status.code, ErrorCode::InvalidArgument) << io::formatName(format);

@@ -113,7 +113,13 @@ struct ReadOptions {
 //   vertices in no face or line. vt and vn lines no corner names are
 //   counted in a note. The writer writes each distinct position, texture
 //   coordinate and normal once, and a vertex whose whole corner equals
-//   another vertex's on a v line of its own.
+//   another vertex's on a v line of its own. Materials (usemtl) label the
+//   lines and faces that follow: by the names' values when every name is a
+//   32-bit decimal integer and no line or face precedes the first usemtl,
+//   otherwise numbered from 0 in order of first use (the unnamed material
+//   of what precedes any usemtl counting as one), with a note listing the
+//   names. The writer writes labels as usemtl lines named by their values.
+//   g, o, s and mtllib lines are counted in a note.
 Status readMemory(Format format, const uint8_t* data, size_t size,
                   Complex& out, Notes& notes, const ReadOptions& options = {});
 Status readFile(const std::string& path, Complex& out, Notes& notes,
@@ -127,6 +133,11 @@ Status readFile(const std::string& path, Complex& out, Notes& notes,
 // Writers refuse a complex with an attribute their format cannot hold
 // (InvalidArgument) rather than drop it.
 bool holdsAttribute(Format format, const VertexAttribute& attribute);
+// Whether files of `format` hold simplex labels exactly: PLY (a `label`
+// property), Medit (element references), TetGen (the region attribute of
+// tetrahedra) and OBJ (usemtl lines whose material names are the labels).
+// Writers refuse a labelled complex otherwise (InvalidArgument).
+bool holdsLabels(Format format);
 
 struct WriteOptions {
   // PLY only: ascii instead of binary little-endian.

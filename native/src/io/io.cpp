@@ -314,6 +314,10 @@ const char* formatName(Format format) {
   return "unknown";
 }
 
+bool holdsLabels(Format format) {
+  return format == Format::Ply || format == Format::Medit || format == Format::TetGen || format == Format::Obj;
+}
+
 bool holdsAttribute(Format format, const VertexAttribute& a) {
   switch (format) {
     case Format::Ply: return true;
@@ -366,13 +370,10 @@ Status checkAttributesWritable(Format format, const Complex& complex) {
                                                        ": write PLY to keep them");
 }
 
-// Simplex labels go to PLY (a `label` property), Medit (element references)
-// and TetGen (the region attribute); other formats refuse them.
 Status checkLabelsWritable(Format format, const Complex& complex) {
-  if (format == Format::Ply || format == Format::Medit || format == Format::TetGen || complex.labels.empty())
-    return Status::success();
+  if (holdsLabels(format) || complex.labels.empty()) return Status::success();
   return Status::error(ErrorCode::InvalidArgument, std::string(formatName(format)) +
-                                                       " cannot hold simplex labels: write PLY or Medit to keep them");
+                                                       " cannot hold simplex labels: write PLY, Medit or OBJ to keep them");
 }
 
 Status writeMemory(Format format, const Complex& complex,

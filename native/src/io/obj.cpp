@@ -1,7 +1,10 @@
 // Wavefront OBJ: vertices, points, polylines and faces, with the texture
 // coordinates (vt) and normals (vn) their corners name as the vertex
-// attributes `uv` and `normal`. Materials, groups and objects are not part
-// of a simplicial complex: their lines are counted in a note.
+// attributes `uv` and `normal`, and the materials (usemtl) of lines and
+// faces as simplex labels (Materials). Groups, objects, smoothing groups
+// and material libraries are not part of a simplicial complex: their lines
+// are counted in a note.
+#include <charconv>
 #include <cstring>
 #include <type_traits>
 #include <unordered_map>
@@ -21,7 +24,6 @@ constexpr struct {
     {"g", "group name (g)", "group names (g)"},
     {"o", "object name (o)", "object names (o)"},
     {"s", "smoothing group (s)", "smoothing groups (s)"},
-    {"usemtl", "material use (usemtl)", "material uses (usemtl)"},
     {"mtllib", "material library (mtllib)", "material libraries (mtllib)"},
 };
 constexpr size_t kSkippedKinds = sizeof kSkippedKeywords / sizeof kSkippedKeywords[0];
@@ -48,6 +50,64 @@ size_t minimumIndices(char keyword) {
     default: return 1;
   }
 }
+
+// The materials (usemtl) of lines and faces as simplex labels. When every
+// material name is a decimal 32-bit integer and no line or face comes
+// before the first usemtl (as writeObj() writes labels), the names are the
+// labels; otherwise materials are numbered from 0 in order of first use,
+// lines and faces before any usemtl counting as one more material.
+class Materials {
+ public:
+  void use(std::string_view name) {
+    current_ = number(name);
+    used_ = true;
+  }
+  // Labels the edges and triangles added since the last call.
+  void label(const Complex& out) {
+    if (current_ < 0) {
+      current_ = number({});  // lines and faces before any usemtl
+      unnamedFirst_ = true;
+    }
+    edges_.resize(out.edges.size() / 2, current_);
+    triangles_.resize(out.triangles.size() / 3, current_);
+  }
+  // Moves the labels into `out` when the file used materials, with a note
+  // of how they were numbered.
+  void finish(Complex& out, Notes& notes) {
+    if (!used_) return;
+    bool integers = !unnamedFirst_;
+    std::vector<int32_t> values(names_.size());
+    for (size_t i = 0; i < names_.size() && integers; ++i) {
+      const std::string& name = names_[i];
+      const auto [end, error] = std::from_chars(name.data(), name.data() + name.size(), values[i]);
+      integers = error == std::errc() && end == name.data() + name.size();
+    }
+    for (auto* list : {&edges_, &triangles_})
+      for (int32_t& label : *list) label = integers ? values[size_t(label)] : label;
+    out.labels.edges = std::move(edges_);
+    out.labels.triangles = std::move(triangles_);
+    if (integers) return;
+    std::string list;
+    constexpr size_t kNamed = 8;
+    for (size_t i = 0; i < std::min(names_.size(), kNamed); ++i)
+      list += (i ? ", " : "") + std::to_string(i) + " " + (names_[i].empty() ? "(none)" : quoted(names_[i]));
+    if (names_.size() > kNamed) list += ", ...";
+    notes.push_back("kept the " + counted(names_.size(), "material", "materials") +
+                    " of lines and faces as simplex labels, numbered in order of first use: " + list);
+  }
+
+ private:
+  int32_t number(std::string_view name) {
+    const auto [at, inserted] = numbers_.emplace(std::string(name), int32_t(names_.size()));
+    if (inserted) names_.emplace_back(name);
+    return at->second;
+  }
+  std::unordered_map<std::string, int32_t> numbers_;
+  std::vector<std::string> names_;
+  std::vector<int32_t> edges_, triangles_;
+  int32_t current_ = -1;
+  bool used_ = false, unnamedFirst_ = false;
+};
 
 constexpr uint32_t kNone = 0xffffffffu;
 // Vertex numbers of corners that name a texture coordinate or a normal
@@ -264,6 +324,7 @@ Status readObj(const uint8_t* data, size_t size, Complex& out, Notes& notes, boo
   size_t extraColumnLines = 0;
   size_t unknownLines = 0;
   size_t skipped[kSkippedKinds] = {};
+  Materials materials;
   std::string firstUnknown;
   bool beyondFloat = false;  // a coordinate that float32 does not hold
   std::string_view keyword;
@@ -287,6 +348,13 @@ Status readObj(const uint8_t* data, size_t size, Complex& out, Notes& notes, boo
       Status status = readIndexLine(scanner, keyword[0], out.vertexCount(), defined, corners, indices);
       if (!status.ok()) return status;
       addSimplices(keyword[0], indices, out, split);
+      if (keyword[0] != 'p') materials.label(out);
+    } else if (keyword == "usemtl") {
+      // The rest of the line is the name (names may hold spaces).
+      std::string_view name, more;
+      scanner.nextToken(name);  // none: the unnamed material, as before any usemtl
+      while (scanner.nextToken(more)) name = std::string_view(name.data(), size_t(more.data() + more.size() - name.data()));
+      materials.use(name);
     } else if (const size_t kind = skippedKind(keyword); kind < kSkippedKinds) {
       ++skipped[kind];
     } else {
@@ -297,6 +365,7 @@ Status readObj(const uint8_t* data, size_t size, Complex& out, Notes& notes, boo
     }
   }
   settleDoubles(out, beyondFloat, keepDoubles, notes);
+  materials.finish(out, notes);
   if (!corners.keys.empty() || defined.uvCount() > 0 || defined.normalCount() > 0)
     makeCornerVertices(defined, corners, out, notes);
   addCountNote(notes, "ignored extra columns (w or colour) on ", extraColumnLines, "vertex line", "vertex lines");
@@ -307,8 +376,8 @@ Status readObj(const uint8_t* data, size_t size, Complex& out, Notes& notes, boo
       lost += (lost.empty() ? "" : ", ") + counted(skipped[i], kSkippedKeywords[i].one, kSkippedKeywords[i].many);
   if (!lost.empty()) {
     notes.push_back("ignored " + lost +
-                    ": kdmesh keeps an OBJ's vertex positions, texture coordinates, normals, faces, lines and points "
-                    "only");
+                    ": kdmesh keeps an OBJ's vertex positions, texture coordinates, normals, faces, lines, points "
+                    "and materials (usemtl) only");
   }
   if (unknownLines > 0) {
     notes.push_back("ignored " + counted(unknownLines, "line", "lines") + " with unknown keywords (the first: " + firstUnknown +
@@ -430,13 +499,27 @@ Status writeObj(const Complex& complex, std::vector<uint8_t>& out) {
     writeCorner(point);
     text.endLine();
   }
+  // Labels as materials named by their values, a usemtl line wherever the
+  // label changes (and before each list's first element), which readObj()
+  // reads back as the same labels.
+  const bool labelled = !complex.labels.empty();
+  int64_t material = -1;  // no label is -1: the first element always names its material
+  auto useMaterial = [&](int dimension, size_t simplex, bool first) {
+    const std::vector<int32_t>& labels = complex.labels.of(dimension);
+    const int32_t label = simplex < labels.size() ? labels[simplex] : 0;
+    if (!labelled || (!first && label == material)) return;
+    material = label;
+    text.word("usemtl").word(std::to_string(label)).endLine();
+  };
   for (size_t i = 0; i < complex.edges.size(); i += 2) {
+    useMaterial(1, i / 2, i == 0);
     text.word("l");
     writeCorner(complex.edges[i]);
     writeCorner(complex.edges[i + 1]);
     text.endLine();
   }
   for (size_t i = 0; i < complex.triangles.size(); i += 3) {
+    useMaterial(2, i / 3, i == 0);
     text.word("f");
     for (size_t k = 0; k < 3; ++k) writeCorner(complex.triangles[i + k]);
     text.endLine();
