@@ -123,7 +123,11 @@ test('streams without labels have no labels', async () => {
 // pieces of `piece` bytes a few milliseconds apart, asks for every level
 // as the page does, and resolves with the header and the levels it handed
 // over.
-async function workerLevels(bytes, piece = 64) {
+// The levels the worker sends while `bytes` arrive, `piece` bytes every
+// `pause` ms. The worker holds snapshots back while received bytes wait
+// (kHandOverShare in web/kdmesh-worker.js): a small stream sent faster than
+// a loaded machine decodes it comes in fewer levels.
+async function workerLevels(bytes, { piece = 64, pause = 3 } = {}) {
   const script = pathToFileURL(join(root, 'web', 'kdmesh-worker.js')).href;
   const worker = new Worker(`
     const { parentPort } = require('node:worker_threads');
@@ -149,7 +153,8 @@ async function workerLevels(bytes, piece = 64) {
         worker.postMessage({ type: 'start' });  // no module: the worker compiles the embedded decoder
         for (let at = 0; at < bytes.length; at += piece) {
           worker.postMessage({ type: 'bytes', bytes: bytes.slice(at, at + piece) });
-          await new Promise((wake) => setTimeout(wake, 3));
+          // Until the header comes back the decoder may still be compiling.
+          await new Promise((wake) => setTimeout(wake, header ? pause : 50));
         }
         worker.postMessage({ type: 'end' });
       });
@@ -247,7 +252,8 @@ test('the boundary of labelled tetrahedra is grouped by the tetrahedra\'s labels
   writeLabelledPly(path, block);
   const out = join(workDir, 'labelled-block.kdm');
   execFileSync(cli, ['encode', path, '-o', out, '--chunk-bytes', '256', '-q']);
-  const { header, levels } = await workerLevels(readFileSync(out));
+  // 2.6 kB: paced so that the worker decodes each piece before the next.
+  const { header, levels } = await workerLevels(readFileSync(out), { pause: 25 });
   assert.deepEqual(Array.from(header.labels), [-3, 7]);
   assert.ok(levels.length >= 3, `levels: ${levels.length}`);
   // Coarse levels may list triangles besides tetrahedra (collapsed ones).
