@@ -232,6 +232,23 @@ Parsed readAttributeTable(const uint8_t* in, size_t available, uint8_t count, st
   return Parsed::Complete;
 }
 
+std::vector<std::vector<uint8_t>> heldValues(const std::vector<VertexAttribute>& attributes,
+                                             const std::vector<AttributeQuantization>& quantization) {
+  std::vector<std::vector<uint8_t>> held(attributes.size());
+  for (size_t a = 0; a < attributes.size(); ++a) {
+    if (quantization[a].kind == AttributeQuantization::Exact) continue;
+    const AttributeCoder::Layout layout = AttributeCoder::layoutOf(attributes[a], quantization[a], 0);
+    const size_t bytes = attributes[a].valueBytes();
+    held[a].resize(attributes[a].values.size());
+    for (size_t at = 0; at < held[a].size(); at += bytes) {
+      uint32_t images[4];
+      AttributeCoder::images(layout, attributes[a].values.data() + at, images);
+      AttributeCoder::store(layout, held[a].data() + at, images);
+    }
+  }
+  return held;
+}
+
 AttributeCoder::AttributeCoder(const std::vector<VertexAttribute>& attributes,
                                const std::vector<AttributeQuantization>* quantization) {
   size_t models = 0;

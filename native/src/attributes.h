@@ -62,6 +62,13 @@ void writeAttributeTable(const std::vector<VertexAttribute>& attributes,
 Parsed readAttributeTable(const uint8_t* in, size_t available, uint8_t count, std::vector<VertexAttribute>& out,
                           size_t& size, Status& error);
 
+// The values of quantized attributes as a decoder holds them, the values
+// their images stand for, one vector per attribute (empty for exact ones,
+// whose values are held as they are). The encoder predicts from these, as
+// the decoder does.
+std::vector<std::vector<uint8_t>> heldValues(const std::vector<VertexAttribute>& attributes,
+                                             const std::vector<AttributeQuantization>& quantization);
+
 class AttributeCoder {
  public:
   // Codes the attributes as `quantization` says (one per attribute), or
@@ -79,7 +86,8 @@ class AttributeCoder {
     uint32_t images[4];
     uint8_t spread[4];
   };
-  // valuesOf(id) gives a vertex's values.
+  // valuesOf(id) gives a vertex's values as the decoder holds them
+  // (heldValues()), and so does `parent`.
   template <class ValuesOf>
   void predict(size_t a, const std::vector<uint32_t>& neighbours, const uint8_t* parent, ValuesOf&& valuesOf,
                Prediction& out) const {
@@ -89,8 +97,13 @@ class AttributeCoder {
       std::fill(out.spread, out.spread + 4, uint8_t(0));
       return;
     }
+    const bool octahedral = layout.kind == AttributeQuantization::Octahedral;
     uint64_t sum[4] = {0, 0, 0, 0};
     uint32_t low[4] = {0xffffffffu, 0xffffffffu, 0xffffffffu, 0xffffffffu}, high[4] = {0, 0, 0, 0};
+    // Octahedral: the range of the images in the mirror image too (code()
+    // takes the images there when the prediction lies in the lower
+    // hemisphere).
+    uint32_t mirroredLow[2] = {0xffffffffu, 0xffffffffu}, mirroredHigh[2] = {0, 0};
     double direction[3] = {0, 0, 0};
     for (const uint32_t v : neighbours) {
       const uint8_t* values = valuesOf(v);
@@ -101,35 +114,23 @@ class AttributeCoder {
         low[c] = std::min(low[c], image[c]);
         high[c] = std::max(high[c], image[c]);
       }
-      // The normal the image stands for: the encoder's input values are
-      // not the decoder's.
-      if (layout.kind == AttributeQuantization::Octahedral) {
-        uint8_t normal[12];
-        store(layout, normal, image);
-        addNormal(normal, direction);
+      if (octahedral) {
+        addNormal(values, direction);  // held values: the normal the image stands for
+        mirrorOctahedral(layout, image);
+        for (int c = 0; c < 2; ++c) {
+          mirroredLow[c] = std::min(mirroredLow[c], image[c]);
+          mirroredHigh[c] = std::max(mirroredHigh[c], image[c]);
+        }
       }
     }
     for (int c = 0; c < layout.components; ++c) {
       out.images[c] = uint32_t((sum[c] + neighbours.size() / 2) / neighbours.size());
       out.spread[c] = uint8_t(bitLength(high[c] - low[c]));
     }
-    if (layout.kind == AttributeQuantization::Octahedral) {
+    if (octahedral) {
       octahedralImages(layout, direction, out.images);
-      // The spread as code() sees the images: in the mirror image when the
-      // prediction lies in the lower hemisphere.
-      if (lowerHemisphere(layout, out.images)) {
-        uint32_t mirroredLow[2] = {0xffffffffu, 0xffffffffu}, mirroredHigh[2] = {0, 0};
-        for (const uint32_t v : neighbours) {
-          uint32_t image[4];
-          images(layout, valuesOf(v), image);
-          mirrorOctahedral(layout, image);
-          for (int c = 0; c < 2; ++c) {
-            mirroredLow[c] = std::min(mirroredLow[c], image[c]);
-            mirroredHigh[c] = std::max(mirroredHigh[c], image[c]);
-          }
-        }
+      if (lowerHemisphere(layout, out.images))
         for (int c = 0; c < 2; ++c) out.spread[c] = uint8_t(bitLength(mirroredHigh[c] - mirroredLow[c]));
-      }
     }
   }
 

@@ -347,6 +347,7 @@ EncodeResult encodeStream(const Complex& complex, const EncodeOptions& options, 
   if (named) writeAttributeTable(complex.attributes, quantization, order.vertices[0], body);
   if (header.labelled) writeLabelTable(labelTable, body);
   AttributeCoder attributeCoder(complex.attributes, &quantization);
+  const std::vector<std::vector<uint8_t>> held = heldValues(complex.attributes, quantization);
   result.cost.attributeBits.assign(complex.attributes.size(), 0.0);
   ChunkWriter chunks(body, options.chunkBytes);
   RangeEncoder& coder = chunks.coder();
@@ -377,6 +378,7 @@ EncodeResult encodeStream(const Complex& complex, const EncodeOptions& options, 
     std::function<void(const char*, double)> report;
     std::vector<LevelCost>& levels;
     const std::vector<VertexAttribute>& attributes;
+    const std::vector<std::vector<uint8_t>>& held;  // heldValues() of the attributes
     const std::vector<uint32_t>& vertexOfKey;
     AttributeCoder& attributeCoder;
     std::vector<double>& attributeBits;
@@ -414,7 +416,7 @@ EncodeResult encodeStream(const Complex& complex, const EncodeOptions& options, 
             neighbours.push_back(forward.vertices(1, edge)[1 - position]);
           });
         for (size_t a = 0; a < attributes.size(); ++a) {
-          const uint8_t* values = attributes[a].values.data();
+          const uint8_t* values = held[a].empty() ? attributes[a].values.data() : held[a].data();
           const size_t bytes = attributes[a].valueBytes();
           AttributeCoder::Prediction prediction;
           uint8_t coded[16];
@@ -443,7 +445,7 @@ EncodeResult encodeStream(const Complex& complex, const EncodeOptions& options, 
     }
   } coding{header,      schedule,          counts,     coder,       chunks,     splitter,
            forward,     predictor,         records,    splitIndex,  connectivityBits, connectivity,
-           report,      result.cost.levels, complex.attributes, order.vertices, attributeCoder,
+           report,      result.cost.levels, complex.attributes, held, order.vertices, attributeCoder,
            result.cost.attributeBits, inputOfId};
   traverseKdTree(order.keys, schedule, connectivity || named, coding);
   header.chunkCount = chunks.finish();
