@@ -520,28 +520,29 @@ struct Decoder::State {
   // Replaces `out` with the model at the current level (Decoder::snapshot):
   // snapshotStream's, then, in a float64 stream, the doubles from the
   // residual attributes (exact once complete; the float32 positions widened
-  // before that), which are left out of the attributes.
+  // before that), which are left out of the attributes (and, before
+  // completion, not copied at all).
   void snapshot(Complex& out, bool takeFinal) {
-    snapshotStream(out, takeFinal);
+    const bool float64 = hasHeader && header.float64();
+    const bool residuals = float64 && attributes.size() >= 2;  // the attribute table has arrived
+    const bool join = residuals && complete();
+    snapshotStream(out, takeFinal, residuals && !join ? attributes.size() - 2 : attributes.size());
     out.positions64.clear();
-    if (!hasHeader || !header.float64()) return;
-    if (out.attributes.size() < 2) {  // before the attribute table
+    if (!float64) return;
+    if (!join) {
       out.positions64.assign(out.positions.begin(), out.positions.end());
       return;
     }
     const size_t user = out.attributes.size() - 2;
-    if (complete())
-      joinFloat64(out.positions, out.attributes[user], out.attributes[user + 1], out.positions64);
-    else
-      out.positions64.assign(out.positions.begin(), out.positions.end());
+    joinFloat64(out.positions, out.attributes[user], out.attributes[user + 1], out.positions64);
     out.attributes.resize(user);
   }
 
-  // The stream's vertices (float32 positions), simplices and attributes;
-  // once complete, `takeFinal` moves the simplex lists out instead of
-  // copying them, for decode(), whose decoder is discarded next (the copy
-  // was 12 bytes per triangle of peak memory).
-  void snapshotStream(Complex& out, bool takeFinal) {
+  // The stream's vertices (float32 positions), simplices and first
+  // `attributeCount` attributes; once complete, `takeFinal` moves the
+  // simplex lists out instead of copying them, for decode(), whose decoder
+  // is discarded next (the copy was 12 bytes per triangle of peak memory).
+  void snapshotStream(Complex& out, bool takeFinal, size_t attributeCount) {
     // Emptied, not replaced: a caller that snapshots level after level into
     // one Complex reuses its memory.
     for (std::vector<uint32_t>* list : {&out.points, &out.edges, &out.triangles, &out.tetrahedra}) list->clear();
@@ -551,8 +552,8 @@ struct Decoder::State {
     const bool finished = complete();
     // Attributes: the descriptors, then values vertex by vertex in the
     // snapshot's order (by id with connectivity, else by cell).
-    out.attributes.resize(attributes.size());
-    for (size_t a = 0; a < attributes.size(); ++a) {
+    out.attributes.resize(attributeCount);
+    for (size_t a = 0; a < attributeCount; ++a) {
       out.attributes[a].name = attributes[a].name;
       out.attributes[a].type = attributes[a].type;
       out.attributes[a].components = attributes[a].components;
@@ -601,7 +602,7 @@ struct Decoder::State {
       // vertex. (With attributes, coincident vertices have cells of their own.)
       const uint32_t copies = finished ? cell.population : 1;
       for (uint32_t i = 0; i < copies; ++i) out.positions.insert(out.positions.end(), position, position + 3);
-      for (size_t a = 0; a < attributes.size(); ++a) {
+      for (size_t a = 0; a < attributeCount; ++a) {
         const size_t bytes = attributes[a].valueBytes();
         const uint8_t* values = attributes[a].values.data() + size_t(cell.vertex) * bytes;
         out.attributes[a].values.insert(out.attributes[a].values.end(), values, values + bytes);

@@ -104,6 +104,8 @@ void expectExactDoubles(const Complex& input) {
     const Complex coarse = prefix.snapshot();
     EXPECT_EQ(coarse.positions64.size(), coarse.positions.size());
     EXPECT_EQ(coarse.attributes.size(), input.attributes.size());
+    for (const VertexAttribute& a : coarse.attributes)
+      EXPECT_EQ(a.values.size(), coarse.vertexCount() * a.valueBytes()) << a.name;
   }
 }
 
