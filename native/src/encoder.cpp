@@ -60,7 +60,12 @@ Status checkOptions(const Complex& complex, const EncodeOptions& options) {
 }
 
 // Writes chunks into the stream body: a frame, then the payload that the
-// range coder produces, closed when it reaches the current target size.
+// range coder produces, closed when it reaches the current target size,
+// which starts at 1 KiB and grows by a quarter each chunk up to the largest
+// chunk size. A prefix decodes whole chunks only, so the bytes of the last,
+// partial chunk wait: growing by a quarter keeps them under a fifth of what
+// has arrived (doubling, up to half), at some 12 bytes of frame, checksum
+// and coder flush per chunk.
 class ChunkWriter {
  public:
   ChunkWriter(std::vector<uint8_t>& body, size_t maxBytes)
@@ -77,7 +82,7 @@ class ChunkWriter {
     ++splits_;
     if (coder_.blockBytes() >= target_) {
       end();
-      target_ = std::min(target_ * 2, maxBytes_);
+      target_ = std::min(target_ + target_ / 4, maxBytes_);
       begin();
     }
   }

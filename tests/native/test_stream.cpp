@@ -116,12 +116,12 @@ TEST(Stream, ProgressReportsBytesLevelsAndChunks) {
   EXPECT_EQ(p.bytesConsumed, bytes.size());
   EXPECT_EQ(p.chunksApplied, d.header().chunkCount);
   EXPECT_EQ(int(p.level), d.header().depth());
-  // Chunks start small and grow to the configured size.
-  ASSERT_GE(d.chunks().size(), 4u);
-  EXPECT_NEAR(d.chunks()[0].payloadBytes, 1024, 16);
-  EXPECT_NEAR(d.chunks()[1].payloadBytes, 2048, 16);
-  EXPECT_NEAR(d.chunks()[2].payloadBytes, 4096, 16);
-  EXPECT_NEAR(d.chunks()[3].payloadBytes, 4096, 16);
+  // Chunks start at 1 KiB and grow by a quarter to the configured size
+  // (docs/FORMAT.md); the last may be shorter.
+  const std::vector<double> targets = {1024, 1280, 1600, 2000, 2500, 3125, 3906, 4096, 4096};
+  ASSERT_GE(d.chunks().size(), targets.size());
+  for (size_t i = 0; i + 1 < d.chunks().size(); ++i)
+    EXPECT_NEAR(d.chunks()[i].payloadBytes, targets[std::min(i, targets.size() - 1)], 16) << "chunk " << i;
 }
 
 // The bits of every level, as the encoder counts them while coding and the

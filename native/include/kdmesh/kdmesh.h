@@ -234,7 +234,8 @@ struct EncodeOptions {
   int attributeBits = 0;
   int normalBits = 0;
   // Largest chunk payload in bytes. The first chunks are smaller (1 KiB,
-  // doubling up to this size) so that a viewer can show something early.
+  // growing by a quarter each up to this size) so that a viewer can show
+  // something early and refine it often.
   size_t chunkBytes = 16 * 1024;
   // Called now and then during long encodes; may be empty.
   std::function<void(const EncodeProgress&)> progress;
