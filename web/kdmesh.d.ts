@@ -27,7 +27,7 @@ export interface DecoderOptions {
   limits?: DecoderLimits;
   /**
    * Where a vertex whose cell is not yet a grid point is drawn before the stream is complete:
-   * on its neighbours' plane, clamped to the cell ('predicted', the default), or at the cell's centre.
+   * halfway from the cell's centre to its neighbours' plane, clamped to the cell ('predicted', the default), or at the cell's centre.
    */
   coarsePlacement?: 'predicted' | 'centre';
 }

@@ -367,7 +367,7 @@ export async function memoryInUse() {
 /**
  * A new progressive decoder. Options: { limits: { maxVertices, maxSimplices, maxChunkBytes,
  * maxVerticesPerByte, maxSimplicesPerByte }, coarsePlacement: 'predicted' (default: a vertex
- * whose cell is not yet a grid point lies on its neighbours' plane, clamped to the cell) or
+ * whose cell is not yet a grid point lies halfway from its cell's centre to its neighbours' plane, clamped to the cell) or
  * 'centre' (at the cell's centre) }.
  */
 export async function createDecoder(options = {}) {

@@ -440,13 +440,17 @@ struct Decoder::State {
 
   // The vertices of an unfinished complex where their neighbours say they
   // lie (CoarsePlacement::Predicted): each cell centre moved along the
-  // vertex's normal (the sum of its triangles' oriented area vectors) onto
-  // the plane through its neighbours' centroid, then clamped to the cell.
-  // Moving along the normal alone keeps the surface from shrinking
-  // tangentially, as a plain neighbour average would at boundaries and
-  // tips. A vertex in no triangle goes to its neighbours' centroid; one in
-  // no edge stays at its cell's centre. Float32 streams place in float
-  // values, whose cells are intervals too.
+  // vertex's normal (the sum of its triangles' oriented area vectors)
+  // halfway to the plane through its neighbours' centroid, then clamped to
+  // the cell. Moving along the normal alone keeps the surface from
+  // shrinking tangentially, as a plain neighbour average would at
+  // boundaries and tips; moving halfway, since the plane through coarse
+  // neighbours cuts across convex parts and spans concave ones, where the
+  // surface lies between it and the cell centre. A vertex in no triangle
+  // goes halfway to its neighbours' centroid; one in no edge stays at its
+  // cell's centre. Float32 streams place in float values, whose cells are
+  // intervals too.
+  static constexpr double kPlaneShare = 0.5;
   void placeOnNeighbourPlanes(std::vector<float>& positions) {
     const size_t n = nextVertex;
     // Floats: the cells' bounds are floats, and the sums need no more for
@@ -505,7 +509,7 @@ struct Decoder::State {
         const double m[3] = {normal[i], normal[i + 1], normal[i + 2]};
         const double squared = m[0] * m[0] + m[1] * m[1] + m[2] * m[2];
         const double along = squared > 0 ? (m[0] * offset[0] + m[1] * offset[1] + m[2] * offset[2]) / squared : 0;
-        for (size_t a = 0; a < 3; ++a) target[a] += squared > 0 ? along * m[a] : offset[a];
+        for (size_t a = 0; a < 3; ++a) target[a] += kPlaneShare * (squared > 0 ? along * m[a] : offset[a]);
       }
       // A float32 stream's infinite or NaN neighbours make no target: the
       // vertex stays at its cell's centre. A cell bound that is not finite

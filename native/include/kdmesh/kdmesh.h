@@ -353,9 +353,10 @@ struct DecoderLimits {
 // Where snapshot() puts the vertex of a cell that is not yet a single grid
 // point, before the stream is complete.
 enum class CoarsePlacement {
-  // On the plane of its neighbours in the complex, clamped to its cell: a
-  // coarse surface looks like the model rather than like voxels. Streams
-  // without simplices place at cell centres.
+  // Moved along its normal halfway from its cell's centre to the plane of
+  // its neighbours in the complex, clamped to its cell: a coarse surface
+  // looks like the model rather than like voxels. Streams without
+  // simplices place at cell centres.
   Predicted,
   // At the centre of its cell.
   CellCentre,
