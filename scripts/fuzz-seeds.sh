@@ -2,8 +2,8 @@
 # Regenerates the decoder fuzzer's seed streams, tests/fuzz/seeds/decoder/,
 # by encoding the reader seeds (tests/fuzz/seeds/) with build/kdmesh, one
 # stream per coding path: connectivity of every dimension on a grid and in
-# float32 mode, exact attributes, quantized and octahedral attributes with
-# labels, a label table, infinite and NaN coordinates, and float64
+# float32 mode, exact attributes, quantized and geometric octahedral
+# attributes with labels, octahedral normals of a point cloud, a label table, infinite and NaN coordinates, and float64
 # coordinates with their residual attributes. Run it after a
 # format change; the test FuzzSeeds.DecoderSeedsDecodeAndCoverEveryTable
 # fails until the streams are current.
@@ -20,5 +20,6 @@ mkdir -p "$out"
 "$cli" encode "$in/colours.ply" -o "$out/attributes.kdm" --exact -q
 "$cli" encode "$in/regions.mesh" -o "$out/labels.kdm" --exact -q
 "$cli" encode "$in/surface.ply" -o "$out/quantized.kdm" --bits 10 --attr-bits 12 --normal-bits 8 -q
+"$cli" encode "$in/oriented.ply" -o "$out/normals.kdm" --bits 8 --normal-bits 6 -q
 "$cli" encode "$in/nonfinite.xyz" -o "$out/nonfinite.kdm" --exact -q
 "$cli" encode "$in/doubles.ply" -o "$out/float64.kdm" --exact -q

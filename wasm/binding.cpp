@@ -201,8 +201,8 @@ EMSCRIPTEN_KEEPALIVE const uint8_t* kdm_attribute_values(KdmDecoder* d, uint32_t
   return d->snapshot.attributes[a].values.data();
 }
 // How the stream codes attribute a: its kdmesh::AttributeQuantization::Kind
-// (exact, uniform, octahedral) and, for the lossy codings, the bits per
-// component (uniform) or per octahedral coordinate.
+// (exact, uniform, octahedral, geometric octahedral) and, for the lossy
+// codings, the bits per component (uniform) or per octahedral coordinate.
 EMSCRIPTEN_KEEPALIVE int kdm_attribute_coding(KdmDecoder* d, uint32_t a) {
   return int(d->snapshot.attributes[a].quantization.kind);
 }

@@ -59,16 +59,19 @@ export interface Header {
  * How a stream codes a vertex attribute (`kdmesh info` names the same): 'exact' keeps every bit;
  * 'uniform' quantizes each float32 component to codingBits bits over its range (encoder option
  * --attr-bits); 'octahedral' codes a float32 × 3 'normal' as unit vectors in two codingBits-bit
- * octahedral coordinates (--normal-bits). The decoded values are float32 either way.
+ * octahedral coordinates (--normal-bits), predicted from its neighbours' normals when the vertex
+ * is created (point clouds, tetrahedral meshes); 'geometric-octahedral' codes a surface's normals
+ * so after the last position bits, predicted from the decoded triangles: until they arrive a
+ * vertex shows the normal of its triangles in the prefix. The decoded values are float32 either way.
  */
-export type AttributeCoding = 'exact' | 'uniform' | 'octahedral';
+export type AttributeCoding = 'exact' | 'uniform' | 'octahedral' | 'geometric-octahedral';
 
 /** A vertex attribute's values: vertexCount · itemSize of its type, as a three.js BufferAttribute takes them. */
 export interface VertexAttribute {
   array: Uint8Array | Int8Array | Uint16Array | Int16Array | Uint32Array | Int32Array | Float32Array;
   itemSize: number;
   coding: AttributeCoding;
-  /** Bits per component ('uniform') or per octahedral coordinate ('octahedral'); 0 when 'exact'. */
+  /** Bits per component ('uniform') or per octahedral coordinate (the octahedral codings); 0 when 'exact'. */
   codingBits: number;
 }
 

@@ -141,7 +141,7 @@ const EMPTY_INDICES = new Uint32Array(0);
 const ATTRIBUTE_ARRAYS = [Uint8Array, Int8Array, Uint16Array, Int16Array, Uint32Array, Int32Array, Float32Array];
 // Names of kdmesh::AttributeQuantization::Kind's values, in its order (as
 // `kdmesh info` names them).
-const ATTRIBUTE_CODINGS = ['exact', 'uniform', 'octahedral'];
+const ATTRIBUTE_CODINGS = ['exact', 'uniform', 'octahedral', 'geometric-octahedral'];
 
 const limitNames = ['maxVertices', 'maxSimplices', 'maxChunkBytes', 'maxVerticesPerByte', 'maxSimplicesPerByte'];
 
@@ -276,9 +276,11 @@ export class Decoder {
    * a typed array of vertexCount · itemSize values, the type's own
    * (Uint8Array for uint8, ...), and how the stream codes them: 'exact'
    * (codingBits 0), 'uniform' (float32 quantized to codingBits bits per
-   * component over its range, the encoder's --attr-bits) or 'octahedral'
+   * component over its range, the encoder's --attr-bits), 'octahedral'
    * (unit normals as two codingBits-bit octahedral coordinates,
-   * --normal-bits). With { copy: false } the arrays
+   * --normal-bits) or 'geometric-octahedral' (the same for a surface's
+   * normals, which arrive after the last position bits: until then a
+   * vertex shows the normal of its triangles). With { copy: false } the arrays
    * are views of WebAssembly memory, valid only until the next call on this
    * decoder; by default they are copies the caller may keep.
    */

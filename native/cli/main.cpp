@@ -367,6 +367,7 @@ const char* codingName(const kdmesh::AttributeQuantization& q) {
   switch (q.kind) {
     case kdmesh::AttributeQuantization::Uniform: return "uniform";
     case kdmesh::AttributeQuantization::Octahedral: return "octahedral";
+    case kdmesh::AttributeQuantization::GeometricOctahedral: return "geometric-octahedral";
     default: return "exact";
   }
 }
@@ -589,7 +590,8 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 24));
   encode->add_option("--normal-bits", encodeArgs.normalBits,
                      "Code the float32 x 3 attribute 'normal' as unit vectors in two N-bit octahedral "
-                     "coordinates (2-16; lossy; default: exact, or --attr-bits)")
+                     "coordinates (2-16; lossy; default: exact, or --attr-bits); a surface's normals "
+                     "come after its positions, predicted from its triangles")
       ->check(CLI::Range(2, 16));
   encode->add_flag("--points-only", encodeArgs.pointsOnly,
                    "Drop edges, triangles and tetrahedra and encode the vertices");

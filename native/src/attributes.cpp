@@ -37,7 +37,7 @@ constexpr double kLeastRelativeStep = 1.0 / (1 << 22);
 bool validUniform(float minimum, float step) { return std::isfinite(minimum) && std::isfinite(step) && step >= 0; }
 
 uint32_t topOf(const AttributeQuantization& q) {
-  return q.kind == AttributeQuantization::Octahedral ? (uint32_t(1) << q.bits) - 2 : uint32_t((uint64_t(1) << q.bits) - 1);
+  return isOctahedral(q.kind) ? (uint32_t(1) << q.bits) - 2 : uint32_t((uint64_t(1) << q.bits) - 1);
 }
 
 float floatAt(const uint8_t* values, int component) {
@@ -50,6 +50,9 @@ float floatAt(const uint8_t* values, int component) {
 
 Status chooseQuantization(const Complex& complex, const EncodeOptions& options,
                           std::vector<AttributeQuantization>& out) {
+  // Normals of a surface are predicted better by its triangles, once
+  // decoded, than by the neighbours' normals when a vertex is created.
+  const bool surface = !complex.triangles.empty();
   if (options.attributeBits != 0 && (options.attributeBits < kMinUniformBits || options.attributeBits > kMaxUniformBits))
     return Status::error(ErrorCode::InvalidArgument, "attribute bits must be 1 to 24, or 0 for exact values");
   if (options.normalBits != 0 && (options.normalBits < kMinOctahedralBits || options.normalBits > kMaxOctahedralBits))
@@ -61,7 +64,7 @@ Status chooseQuantization(const Complex& complex, const EncodeOptions& options,
     AttributeQuantization& q = out[i];
     if (a.type != AttributeType::Float32) continue;
     if (options.normalBits > 0 && isNormal(a)) {
-      q.kind = AttributeQuantization::Octahedral;
+      q.kind = surface ? AttributeQuantization::GeometricOctahedral : AttributeQuantization::Octahedral;
       q.bits = uint8_t(options.normalBits);
     } else if (options.attributeBits > 0) {
       q.kind = AttributeQuantization::Uniform;
@@ -198,7 +201,7 @@ Parsed readAttributeTable(const uint8_t* in, size_t available, uint8_t count, st
       if (other.name == a.name) return malformed("two attributes named '" + a.name + "'");
     AttributeQuantization& q = a.quantization;
     const uint8_t kind = in[at++];
-    if (kind > AttributeQuantization::Octahedral) return malformed("unknown coding of '" + a.name + "'");
+    if (kind > AttributeQuantization::GeometricOctahedral) return malformed("unknown coding of '" + a.name + "'");
     q.kind = AttributeQuantization::Kind(kind);
     if (q.kind != AttributeQuantization::Exact) {
       if (available - at < 1) return Parsed::Incomplete;
@@ -270,7 +273,7 @@ AttributeCoder::Layout AttributeCoder::layoutOf(const VertexAttribute& a, const 
     layout.components = a.components;
     layout.bits = 8 * layout.bytes;
   } else {
-    layout.components = q.kind == AttributeQuantization::Octahedral ? 2 : a.components;
+    layout.components = isOctahedral(q.kind) ? 2 : a.components;
     layout.bits = q.bits;
     layout.top = topOf(q);
     for (int c = 0; c < 4; ++c) layout.minimum[c] = q.minimum[size_t(c)], layout.step[c] = q.step[size_t(c)];
@@ -360,6 +363,44 @@ void AttributeCoder::mirrorOctahedral(const Layout& layout, uint32_t* images) {
   images[1] = uint32_t((mirroredV + top) / 2);
 }
 
+void AttributeCoder::unitNormal(const double* sums, double* out) {
+  const double length = std::sqrt(sums[0] * sums[0] + sums[1] * sums[1] + sums[2] * sums[2]);
+  for (int c = 0; c < 3; ++c) out[c] = length > 0 ? sums[c] / length : 0.0;
+}
+
+uint8_t AttributeCoder::agreementSpread(const double* sums) {
+  const double length = std::sqrt(sums[0] * sums[0] + sums[1] * sums[1] + sums[2] * sums[2]);
+  const double agreement = sums[3] > 0 ? length / sums[3] : 0;
+  return agreement >= 0.9 ? 0 : agreement >= 0.7 ? 1 : agreement >= 0.5 ? 3 : 6;
+}
+
+void AttributeCoder::holdDirection(size_t a, const double* direction, uint8_t* values) const {
+  uint32_t images[4];
+  encodeOctahedral(direction, layouts_[a].top, images);
+  store(layouts_[a], values, images);
+}
+
+void triangleAreaVectors(const SimplexStore& store, const std::vector<float>& positions, std::vector<double>& out) {
+  const size_t n = positions.size() / 3;
+  out.assign(n * 4, 0.0);
+  for (uint32_t vertex = 0; vertex < n; ++vertex) {
+    double* sum = &out[size_t(vertex) * 4];
+    const float* p = &positions[size_t(vertex) * 3];
+    store.forEachIncident(2, vertex, [&](uint32_t triangle, uint32_t position) {
+      // The two vertices that follow this one in the triangle's winding.
+      const uint32_t* v = store.vertices(2, triangle);
+      const bool flipped = (store.flags(2, triangle) & SimplexStore::kFlipped) != 0;
+      const float* a = &positions[size_t(v[(position + (flipped ? 2 : 1)) % 3]) * 3];
+      const float* b = &positions[size_t(v[(position + (flipped ? 1 : 2)) % 3]) * 3];
+      const double u[3] = {double(a[0]) - p[0], double(a[1]) - p[1], double(a[2]) - p[2]};
+      const double w[3] = {double(b[0]) - p[0], double(b[1]) - p[1], double(b[2]) - p[2]};
+      const double area[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
+      for (int c = 0; c < 3; ++c) sum[c] += area[c];
+      sum[3] += std::sqrt(area[0] * area[0] + area[1] * area[1] + area[2] * area[2]);
+    });
+  }
+}
+
 void AttributeCoder::octahedralImages(const Layout& layout, const double* direction, uint32_t* out) {
   encodeOctahedral(direction, layout.top, out);
 }
@@ -382,7 +423,8 @@ void AttributeCoder::images(const Layout& layout, const uint8_t* values, uint32_
         out[c] = x >= 0 ? (x <= double(layout.top) ? uint32_t(x) : layout.top) : 0;  // NaN: 0
       }
       return;
-    case AttributeQuantization::Octahedral: {
+    case AttributeQuantization::Octahedral:
+    case AttributeQuantization::GeometricOctahedral: {
       const double d[3] = {floatAt(values, 0), floatAt(values, 1), floatAt(values, 2)};
       encodeOctahedral(d, layout.top, out);
       return;
@@ -405,7 +447,8 @@ void AttributeCoder::store(const Layout& layout, uint8_t* values, const uint32_t
         std::memcpy(values + 4 * c, &x, 4);
       }
       return;
-    case AttributeQuantization::Octahedral: {
+    case AttributeQuantization::Octahedral:
+    case AttributeQuantization::GeometricOctahedral: {
       float normal[3];
       decodeOctahedral(images, layout.top, normal);
       std::memcpy(values, normal, 12);

@@ -23,19 +23,33 @@
 // values they stand for, and the mapping back from those floats to the
 // images is exact (docs/FORMAT.md), so encoder and decoder predict from
 // the same images.
+//
+// Geometric octahedral attributes (a surface's normals) wait until the
+// kd-tree is complete: then each vertex's values are coded, vertex by
+// vertex, against the normal of its triangles in the final complex,
+// corrected by that normal's error at its neighbours already decoded.
+// Normals made from the surface are predicted far better so than by
+// coarse neighbours at the vertex's creation; a prefix shows the normals
+// of its own triangles meanwhile.
 #pragma once
 
 #include <algorithm>
 #include <array>
 #include <cstdint>
+#include <cstring>
 #include <string>
 #include <vector>
 
 #include "container.h"
 #include "kdmesh/kdmesh.h"
 #include "range_coder.h"
+#include "simplex_store.h"
 
 namespace kdmesh {
+
+inline bool isOctahedral(AttributeQuantization::Kind kind) {
+  return kind == AttributeQuantization::Octahedral || kind == AttributeQuantization::GeometricOctahedral;
+}
 
 // Whether the complex's attributes can be encoded: at most kMaxAttributes,
 // names of 1..kMaxAttributeNameBytes printable ASCII characters without
@@ -69,6 +83,14 @@ Parsed readAttributeTable(const uint8_t* in, size_t available, uint8_t count, st
 std::vector<std::vector<uint8_t>> heldValues(const std::vector<VertexAttribute>& attributes,
                                              const std::vector<AttributeQuantization>& quantization);
 
+// For each vertex, the sum of the oriented area vectors of its triangles
+// in `store` and the sum of their lengths, over `positions` (3 floats per
+// vertex): 4 doubles per vertex in `out`, the sums of geometric octahedral
+// predictions. Each vertex walks its own incidence list (docs/FORMAT.md),
+// so encoder and decoder, which hold the same store, add in the same order
+// and agree to the bit.
+void triangleAreaVectors(const SimplexStore& store, const std::vector<float>& positions, std::vector<double>& out);
+
 class AttributeCoder {
  public:
   // Codes the attributes as `quantization` says (one per attribute), or
@@ -97,7 +119,7 @@ class AttributeCoder {
       std::fill(out.spread, out.spread + 4, uint8_t(0));
       return;
     }
-    const bool octahedral = layout.kind == AttributeQuantization::Octahedral;
+    const bool octahedral = isOctahedral(layout.kind);
     uint64_t sum[4] = {0, 0, 0, 0};
     uint32_t low[4] = {0xffffffffu, 0xffffffffu, 0xffffffffu, 0xffffffffu}, high[4] = {0, 0, 0, 0};
     // Octahedral: the range of the images in the mirror image too (code()
@@ -134,6 +156,43 @@ class AttributeCoder {
     }
   }
 
+  // A geometric octahedral attribute's prediction for `vertex` from the
+  // sums of triangleAreaVectors() (4 per vertex): the unit normal of its
+  // triangles (their area vectors' sum; none give +z), moved by
+  // kNeighbourErrorShare of the mean error of that normal at its
+  // neighbours whose values are known (`decoded`: their held values by
+  // valuesOf(id)), since the quantization of the positions tilts nearby
+  // normals alike; trusted as far as its triangles agree (the sum's length
+  // against the sum of lengths).
+  template <class ValuesOf>
+  void predictFromTriangles(size_t a, const std::vector<double>& sums, uint32_t vertex,
+                            const std::vector<uint32_t>& decoded, ValuesOf&& valuesOf, Prediction& out) const {
+    double direction[3];
+    unitNormal(&sums[size_t(vertex) * 4], direction);
+    if (!decoded.empty()) {
+      double error[3] = {0, 0, 0};
+      for (const uint32_t n : decoded) {
+        double predicted[3];
+        unitNormal(&sums[size_t(n) * 4], predicted);
+        const uint8_t* values = valuesOf(n);
+        for (int c = 0; c < 3; ++c) {
+          float held;
+          std::memcpy(&held, values + 4 * c, 4);
+          error[c] += double(held) - predicted[c];
+        }
+      }
+      const double share = kNeighbourErrorShare / double(decoded.size());
+      for (int c = 0; c < 3; ++c) direction[c] += share * error[c];
+    }
+    octahedralImages(layouts_[a], direction, out.images);
+    std::fill(out.spread, out.spread + 4, agreementSpread(&sums[size_t(vertex) * 4]));
+  }
+  // Writes to `values` the normal of attribute `a` that `direction` stands
+  // for, as a decoder holds it (the quantized unit vector).
+  void holdDirection(size_t a, const double* direction, uint8_t* values) const;
+  // Whether attribute `a` is coded after the kd-tree (GeometricOctahedral).
+  bool codedAfterGeometry(size_t a) const { return layouts_[a].kind == AttributeQuantization::GeometricOctahedral; }
+
   // Codes the values of one vertex of attribute `a` (encoder: `child`; the
   // decoder writes them there) against `prediction`.
   template <class Coder>
@@ -146,7 +205,7 @@ class AttributeCoder {
     // image (z negated), where the prediction lies in the diamond and its
     // neighbourhood away from the square's edges, across which the
     // octahedral map jumps.
-    const bool mirrored = layout.kind == AttributeQuantization::Octahedral && lowerHemisphere(layout, predicted);
+    const bool mirrored = isOctahedral(layout.kind) && lowerHemisphere(layout, predicted);
     if (mirrored) {
       mirrorOctahedral(layout, predicted);
       mirrorOctahedral(layout, to);
@@ -198,6 +257,12 @@ class AttributeCoder {
   static constexpr int kLengthClasses = 4;
   static int lengthClass(int length) { return length == 0 ? 0 : length <= 2 ? 1 : length <= 5 ? 2 : 3; }
   static void addNormal(const uint8_t* values, double* sum);
+  static constexpr double kNeighbourErrorShare = 0.375;
+  // The unit vector of sums[0..3) (zero stays zero).
+  static void unitNormal(const double* sums, double* out);
+  // A spread (as lengthClass() reads it) for how far a vertex's triangles
+  // agree on its normal (4 sums of triangleAreaVectors()).
+  static uint8_t agreementSpread(const double* sums);
   static void octahedralImages(const Layout& layout, const double* direction, uint32_t* out);
 
   // Codes a `bits`-bit difference (two's complement); returns it and the

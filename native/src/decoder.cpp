@@ -84,6 +84,12 @@ struct Decoder::State {
   std::optional<AttributeCoder> attributeCoder;
   bool attributeTableRead = false;
   std::vector<uint32_t> neighbours;  // of the vertex whose attributes are decoded
+  // Attributes coded after the kd-tree (GeometricOctahedral): the next
+  // vertex whose values come, the last one's id + 1 once all have (vertex
+  // 0's are in the table), and triangleAreaVectors() of the final complex.
+  bool afterGeometry = false;
+  uint32_t nextAfterGeometry = 1;
+  std::vector<double> triangleSums;
   // Simplex labels: the table after the attribute table; the store holds
   // indices into it.
   std::vector<int32_t> labelTable;
@@ -102,15 +108,20 @@ struct Decoder::State {
     std::vector<uint32_t> facetStart, edgeFacets;
     std::vector<uint64_t> triangleFacets;
     std::vector<uint8_t> isFace;
-    std::vector<float> centre, low, high, sum, normal;  // placeOnNeighbourPlanes()
+    std::vector<float> centre, low, high, sum, normal;  // placeOnNeighbourPlanes(), holdTriangleNormals()
     std::vector<uint32_t> degree;
   } scratch;
 
   explicit State(const DecoderOptions& o) : options(o) {}
 
-  bool complete() const {
+  // Every cell split, down to the last level (and coincident vertices apart).
+  bool kdTreeComplete() const {
     return hasHeader && attributeTableRead && labelTableRead && level >= schedule->levels &&
            (!named || cells.empty());
+  }
+
+  bool complete() const {
+    return kdTreeComplete() && (!afterGeometry || nextAfterGeometry >= header.vertexCount);
   }
 
   Status fail(Status status) {
@@ -164,6 +175,11 @@ struct Decoder::State {
       if (complete())
         return Status::error(ErrorCode::CorruptChunk,
                              where + ": more splits than the kd-tree has cells");
+      if (kdTreeComplete()) {
+        decodeAfterGeometry();
+        --left;
+        continue;
+      }
       if (cursor < cells.size()) {
         if (!splitCell(cells[cursor++]))
           return Status::error(ErrorCode::CorruptChunk,
@@ -250,6 +266,7 @@ struct Decoder::State {
   }
 
   // The values of a new vertex, against its neighbours' (or its parent's).
+  // Those of attributes coded after the kd-tree are its parent's until then.
   void decodeAttributes(uint32_t parent, uint32_t vertex) {
     neighbours.clear();
     if (connectivity)
@@ -262,6 +279,10 @@ struct Decoder::State {
       if (values.size() < (size_t(vertex) + 1) * bytes)
         values.resize(std::min<size_t>(header.vertexCount, std::max<size_t>(vertex + 1, 2 * values.size() / bytes)) *
                       bytes);
+      if (attributeCoder->codedAfterGeometry(a)) {
+        std::memcpy(values.data() + size_t(vertex) * bytes, values.data() + size_t(parent) * bytes, bytes);
+        continue;
+      }
       AttributeCoder::Prediction prediction;
       attributeCoder->predict(a, neighbours, values.data() + size_t(parent) * bytes,
                               [&](uint32_t id) { return values.data() + size_t(id) * bytes; }, prediction);
@@ -269,6 +290,45 @@ struct Decoder::State {
       attributeCoder->code(coder, a, prediction, values.data() + size_t(vertex) * bytes);
       cost.attributeBits[a] += coder.cost() - before;
     }
+  }
+
+  // The values of the next vertex of the attributes coded after the
+  // kd-tree, against its triangles' normal; the first call finds the
+  // normals of all vertices.
+  void decodeAfterGeometry() {
+    if (triangleSums.empty()) {
+      std::vector<float> positions(size_t(nextVertex) * 3);
+      forEachCurrentCell([&](const Cell& cell, int cellLevel) {
+        for (int a = 0; a < 3; ++a) {
+          uint32_t lo, hi;
+          cellRange(cell, cellLevel, a, lo, hi);
+          positions[size_t(cell.vertex) * 3 + size_t(a)] = dequantizer->position(a, lo, hi);
+        }
+      });
+      if (connectivity)
+        triangleAreaVectors(store, positions, triangleSums);
+      else
+        triangleSums.assign(positions.size() / 3 * 4, 0.0);
+    }
+    const uint32_t vertex = nextAfterGeometry++;
+    neighbours.clear();  // those of lower ids, decoded
+    if (connectivity)
+      store.forEachIncident(1, vertex, [&](uint32_t edge, uint32_t position) {
+        const uint32_t n = store.vertices(1, edge)[1 - position];
+        if (n < vertex) neighbours.push_back(n);
+      });
+    for (size_t a = 0; a < attributes.size(); ++a) {
+      if (!attributeCoder->codedAfterGeometry(a)) continue;
+      const size_t bytes = attributes[a].valueBytes();
+      const uint8_t* values = attributes[a].values.data();
+      AttributeCoder::Prediction prediction;
+      attributeCoder->predictFromTriangles(
+          a, triangleSums, vertex, neighbours, [&](uint32_t n) { return values + size_t(n) * bytes; }, prediction);
+      const double before = coder.cost();
+      attributeCoder->code(coder, a, prediction, attributes[a].values.data() + size_t(vertex) * bytes);
+      cost.attributeBits[a] += coder.cost() - before;
+    }
+    if (nextAfterGeometry == header.vertexCount) triangleSums = {};
   }
 
   void refineSingles(size_t begin, size_t end) {
@@ -462,7 +522,6 @@ struct Decoder::State {
     low.resize(n * 3);
     high.resize(n * 3);
     sum.assign(n * 3, 0.0f);
-    normal.assign(n * 3, 0.0f);
     degree.assign(n, 0);
     forEachCurrentCell([&](const Cell& cell, int cellLevel) {
       for (int a = 0; a < 3; ++a) {
@@ -485,20 +544,7 @@ struct Decoder::State {
       ++degree[v[0]];
       ++degree[v[1]];
     }
-    for (uint32_t triangle = 0; triangle < store.size(2); ++triangle) {
-      const uint8_t flags = store.flags(2, triangle);
-      if (!(flags & SimplexStore::kAlive)) continue;
-      const uint32_t* v = store.vertices(2, triangle);
-      const float* p = &centre[size_t(v[0]) * 3];
-      const float* q = &centre[size_t(v[1]) * 3];
-      const float* r = &centre[size_t(v[2]) * 3];
-      const double u[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]}, w[3] = {r[0] - p[0], r[1] - p[1], r[2] - p[2]};
-      const double sign = flags & SimplexStore::kFlipped ? -1.0 : 1.0;
-      const double area[3] = {sign * (u[1] * w[2] - u[2] * w[1]), sign * (u[2] * w[0] - u[0] * w[2]),
-                              sign * (u[0] * w[1] - u[1] * w[0])};
-      for (int k = 0; k < 3; ++k)
-        for (size_t a = 0; a < 3; ++a) normal[size_t(v[k]) * 3 + a] += float(area[a]);
-    }
+    sumTriangleNormals(centre, normal);
     positions.resize(n * 3);
     for (size_t v = 0; v < n; ++v) {
       const size_t i = v * 3;
@@ -518,6 +564,44 @@ struct Decoder::State {
         positions[i + a] = std::isfinite(target[a])
                                ? float(std::clamp(target[a], double(low[i + a]), double(high[i + a])))
                                : centre[i + a];
+    }
+  }
+
+  // Per vertex in `normal` (3 floats), the sum of the oriented area
+  // vectors of the complex's triangles around it, over `positions`.
+  void sumTriangleNormals(const std::vector<float>& positions, std::vector<float>& normal) {
+    normal.assign(positions.size(), 0.0f);
+    for (uint32_t triangle = 0; triangle < store.size(2); ++triangle) {
+      const uint8_t flags = store.flags(2, triangle);
+      if (!(flags & SimplexStore::kAlive)) continue;
+      const uint32_t* v = store.vertices(2, triangle);
+      const float* p = &positions[size_t(v[0]) * 3];
+      const float* q = &positions[size_t(v[1]) * 3];
+      const float* r = &positions[size_t(v[2]) * 3];
+      const double u[3] = {q[0] - p[0], q[1] - p[1], q[2] - p[2]}, w[3] = {r[0] - p[0], r[1] - p[1], r[2] - p[2]};
+      const double sign = flags & SimplexStore::kFlipped ? -1.0 : 1.0;
+      const double area[3] = {sign * (u[1] * w[2] - u[2] * w[1]), sign * (u[2] * w[0] - u[0] * w[2]),
+                              sign * (u[0] * w[1] - u[1] * w[0])};
+      for (int k = 0; k < 3; ++k)
+        for (size_t a = 0; a < 3; ++a) normal[size_t(v[k]) * 3 + a] += float(area[a]);
+    }
+  }
+
+  // Until their values arrive, the vertices of attributes coded after the
+  // kd-tree show the normals of their triangles in the snapshot `out` (a
+  // vertex in none keeps its parent's values).
+  void holdTriangleNormals(Complex& out, size_t attributeCount) {
+    if (!afterGeometry || nextAfterGeometry >= nextVertex) return;
+    std::vector<float>& normal = scratch.normal;
+    sumTriangleNormals(out.positions, normal);
+    for (size_t a = 0; a < attributeCount; ++a) {
+      if (!attributeCoder->codedAfterGeometry(a)) continue;
+      const size_t bytes = attributes[a].valueBytes();
+      for (uint32_t v = nextAfterGeometry; v < nextVertex; ++v) {
+        const double direction[3] = {normal[size_t(v) * 3], normal[size_t(v) * 3 + 1], normal[size_t(v) * 3 + 2]};
+        if (direction[0] != 0 || direction[1] != 0 || direction[2] != 0)
+          attributeCoder->holdDirection(a, direction, out.attributes[a].values.data() + size_t(v) * bytes);
+      }
     }
   }
 
@@ -569,9 +653,10 @@ struct Decoder::State {
       }
     }
     if (connectivity) {
-      if (!finished && options.coarsePlacement == CoarsePlacement::Predicted) {
+      if (!kdTreeComplete() && options.coarsePlacement == CoarsePlacement::Predicted) {
         placeOnNeighbourPlanes(out.positions);
         appendSimplices(out);
+        holdTriangleNormals(out, attributeCount);
         return;
       }
       out.positions.resize(size_t(nextVertex) * 3);
@@ -584,6 +669,7 @@ struct Decoder::State {
       });
       if (!finished) {
         appendSimplices(out);
+        holdTriangleNormals(out, attributeCount);
         return;
       }
       std::vector<uint32_t>* from[4] = {&finalComplex.points, &finalComplex.edges, &finalComplex.triangles,
@@ -647,6 +733,7 @@ struct Decoder::State {
           break;
         }
         attributeCoder.emplace(attributes);
+        for (size_t a = 0; a < attributes.size(); ++a) afterGeometry |= attributeCoder->codedAfterGeometry(a);
         cost.attributeBits.assign(attributes.size(), 0.0);
         attributeTableRead = true;
         offset += tableBytes;

@@ -1,6 +1,7 @@
 // The encoder: quantize, order the vertices along the kd-tree, then code the
 // count of every cell split, level by level, into checksummed chunks.
 #include <algorithm>
+#include <cmath>
 #include <cstring>
 #include <string>
 
@@ -297,7 +298,10 @@ EncodeResult encodeStream(const Complex& complex, const EncodeOptions& options, 
   const SplitSchedule schedule(header);
   report("sort", 0);
   KdOrder order = kdOrder(coords, schedule);
-  coords = {};
+  bool afterGeometry = false;  // attributes coded once the kd-tree is complete, which need the positions
+  for (const AttributeQuantization& q : quantization)
+    afterGeometry |= q.kind == AttributeQuantization::GeometricOctahedral;
+  if (!afterGeometry) coords = {};
 
   // Connectivity, fine to coarse: name the vertices as the decoder will,
   // build the input complex on those names, and merge cells in the reverse
@@ -412,7 +416,8 @@ EncodeResult encodeStream(const Complex& complex, const EncodeOptions& options, 
         connectivityBits += coder.cost() - before;
       }
       // The second half's vertex: the values of its first input vertex,
-      // against those of the cell's first.
+      // against those of the cell's first (attributes coded after the
+      // kd-tree wait).
       if (added != kNoSimplex && !attributes.empty()) {
         const uint32_t parent = vertexOfKey[firstKey], child = vertexOfKey[firstKey + firstHalf];
         neighbours.clear();
@@ -421,6 +426,7 @@ EncodeResult encodeStream(const Complex& complex, const EncodeOptions& options, 
             neighbours.push_back(forward.vertices(1, edge)[1 - position]);
           });
         for (size_t a = 0; a < attributes.size(); ++a) {
+          if (attributeCoder.codedAfterGeometry(a)) continue;
           const uint8_t* values = held[a].empty() ? attributes[a].values.data() : held[a].data();
           const size_t bytes = attributes[a].valueBytes();
           AttributeCoder::Prediction prediction;
@@ -453,6 +459,41 @@ EncodeResult encodeStream(const Complex& complex, const EncodeOptions& options, 
            report,      result.cost.levels, complex.attributes, held, order.vertices, attributeCoder,
            result.cost.attributeBits, inputOfId};
   traverseKdTree(order.keys, schedule, connectivity || named, coding);
+  if (afterGeometry) {
+    // Vertex by vertex, all but the root (whose values are in the table),
+    // against the normal of its triangles at the decoded positions.
+    const Dequantizer dequantizer(header);
+    std::vector<float> positions(size_t(header.vertexCount) * 3);
+    for (uint32_t id = 0; id < header.vertexCount; ++id)
+      for (int a = 0; a < 3; ++a) {
+        const uint32_t c = coords[size_t(inputOfId[id]) * 3 + size_t(a)];
+        positions[size_t(id) * 3 + size_t(a)] = dequantizer.position(a, c, c);
+      }
+    std::vector<double> sums;
+    triangleAreaVectors(forward, positions, sums);
+    std::vector<uint32_t> decoded;  // neighbours of lower ids
+    for (uint32_t id = 1; id < header.vertexCount; ++id) {
+      decoded.clear();
+      forward.forEachIncident(1, id, [&](uint32_t edge, uint32_t position) {
+        const uint32_t n = forward.vertices(1, edge)[1 - position];
+        if (n < id) decoded.push_back(n);
+      });
+      for (size_t a = 0; a < complex.attributes.size(); ++a) {
+        if (!attributeCoder.codedAfterGeometry(a)) continue;
+        const size_t bytes = complex.attributes[a].valueBytes();
+        AttributeCoder::Prediction prediction;
+        attributeCoder.predictFromTriangles(
+            a, sums, id, decoded, [&](uint32_t n) { return held[a].data() + size_t(inputOfId[n]) * bytes; },
+            prediction);
+        uint8_t coded[16];
+        std::memcpy(coded, held[a].data() + size_t(inputOfId[id]) * bytes, bytes);
+        const double before = coder.cost();
+        attributeCoder.code(coder, a, prediction, coded);
+        result.cost.attributeBits[a] += coder.cost() - before;
+      }
+      chunks.splitDone();
+    }
+  }
   header.chunkCount = chunks.finish();
   header.bodyBytes = body.size();
   result.cost.labelBits = splitter.labelBits();

@@ -319,7 +319,7 @@ test('the status line says how quantized attributes are coded', async () => {
   const { page, errors } = await openViewer('model=quantized.kdm');
   await page.waitForFunction(() => window.kdmeshViewer.state === 'complete', null, { timeout: 60000 });
   await page.waitForFunction(() => !document.getElementById('status').textContent.includes('so far'), null, { timeout: 10000 });
-  assert.match(await page.textContent('#status'), / · color, normal \(octahedral 10 bits\), uv \(uniform 12 bits\), label · /);
+  assert.match(await page.textContent('#status'), / · color, normal \(geometric-octahedral 10 bits\), uv \(uniform 12 bits\), label · /);
   assert.deepEqual(errors, []);
   await page.close();
 });

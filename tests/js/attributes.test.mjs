@@ -132,15 +132,46 @@ test('in pieces: every prefix snapshot has whole attributes of input values, cut
   }
 });
 
+test('normals coded after the positions: prefixes show unit normals as the native decoder does', async () => {
+  const shape = shapes.torus;
+  const ply = join(workDir, 'torus-normals.ply');
+  writePly(ply, shape);
+  const kdm = join(workDir, 'torus-normals.kdm');
+  execFileSync(cli, ['encode', ply, '-o', kdm, '--bits', '12', '--normal-bits', '10', '--chunk-bytes', '256', '-q']);
+  const bytes = readFileSync(kdm);
+  const decoder = await createDecoder();
+  let compared = 0;
+  for (let at = 0; at < bytes.length;) {
+    const end = Math.min(bytes.length, at + 700);
+    const applied = decoder.push(bytes.subarray(at, end)).chunksApplied > 0;
+    at = end;
+    const model = decoder.snapshot();
+    const normal = model.attributes.normal;
+    if (!normal) continue;
+    assert.equal(normal.coding, 'geometric-octahedral');
+    for (let v = 0; v < model.vertexCount; ++v) {
+      const [x, y, z] = normal.array.subarray(3 * v, 3 * v + 3);
+      assert.ok(Math.abs(x * x + y * y + z * z - 1) < 1e-5, `vertex ${v} at ${at} bytes: a unit normal`);
+    }
+    if (applied) {
+      assertSameAttributes(model.attributes, nativeAttributes(nativeDecode(kdm, at), shape), `at ${at} bytes`);
+      ++compared;
+    }
+  }
+  decoder.finish();
+  decoder.dispose();
+  assert.ok(compared >= 3, `${compared} prefixes compared`);
+});
+
 test('each attribute says how the stream codes it, as kdmesh info does, at every prefix', async () => {
   const codings = (attributes) => Object.entries(attributes).map(([name, { coding, codingBits }]) => [name, coding, codingBits]);
   const cases = [
     [shapes.torus, ['--attr-bits', '12', '--normal-bits', '10'],
-      [['color', 'exact', 0], ['normal', 'octahedral', 10], ['uv', 'uniform', 12], ['label', 'exact', 0]]],
+      [['color', 'exact', 0], ['normal', 'geometric-octahedral', 10], ['uv', 'uniform', 12], ['label', 'exact', 0]]],
     [shapes.torus, ['--attr-bits', '7'],  // without --normal-bits, normals are quantized like any float32
       [['color', 'exact', 0], ['normal', 'uniform', 7], ['uv', 'uniform', 7], ['label', 'exact', 0]]],
     [shapes.torus, ['--normal-bits', '8'],
-      [['color', 'exact', 0], ['normal', 'octahedral', 8], ['uv', 'exact', 0], ['label', 'exact', 0]]],
+      [['color', 'exact', 0], ['normal', 'geometric-octahedral', 8], ['uv', 'exact', 0], ['label', 'exact', 0]]],
     [shapes.cloud, ['--normal-bits', '8'], [['color', 'exact', 0], ['intensity', 'exact', 0]]],
     [shapes.cloud, ['--attr-bits', '9'], [['color', 'exact', 0], ['intensity', 'uniform', 9]]],
   ];

@@ -329,7 +329,7 @@ TEST(AttributeQuantization, DecodesToTheQuantizedInputOnEveryPrefix) {
       const AttributeQuantization& q = decoded.attributes[a].quantization;
       const AttributeQuantization::Kind kind =
           mesh.attributes[a].type != AttributeType::Float32 ? AttributeQuantization::Exact
-          : a == 0 && normalBits > 0                        ? AttributeQuantization::Octahedral
+          : a == 0 && normalBits > 0                        ? AttributeQuantization::GeometricOctahedral
           : attributeBits > 0                               ? AttributeQuantization::Uniform
                                                             : AttributeQuantization::Exact;
       ASSERT_EQ(q.kind, kind) << mesh.attributes[a].name;
@@ -356,8 +356,17 @@ TEST(AttributeQuantization, DecodesToTheQuantizedInputOnEveryPrefix) {
       return keys;
     };
     EXPECT_TRUE(sortedKeys(decoded) == sortedKeys(expected)) << "decoded values are not the quantized input";
+    // Prefixes: each vertex has the values of an input vertex, but for
+    // normals coded after the kd-tree, which are unit vectors and, on a
+    // vertex of the prefix's triangles, the outward normal of the surface.
+    const bool geometricNormals = normalBits > 0;
+    auto withoutNormals = [geometricNormals](Complex c) {
+      if (geometricNormals) c.attributes.erase(c.attributes.begin());
+      return c;
+    };
     std::set<VertexKey> values;
-    for (const VertexKey& key : vertexKeys(expected)) values.insert(VertexKey(key.begin() + 12, key.end()));
+    for (const VertexKey& key : vertexKeys(withoutNormals(expected)))
+      values.insert(VertexKey(key.begin() + 12, key.end()));
     Decoder whole;
     ASSERT_TRUE(whole.push(encoded.bytes.data(), encoded.bytes.size()).ok());
     ASSERT_GT(whole.chunks().size(), 2u);
@@ -368,8 +377,19 @@ TEST(AttributeQuantization, DecodesToTheQuantizedInputOnEveryPrefix) {
       const Complex coarse = prefix.snapshot();
       if (coarse.attributes.empty()) continue;
       expectSameDescriptors(mesh, coarse);
-      for (const VertexKey& key : vertexKeys(coarse))
+      for (const VertexKey& key : vertexKeys(withoutNormals(coarse)))
         ASSERT_TRUE(values.count(VertexKey(key.begin() + 12, key.end()))) << "prefix of " << chunk.offset;
+      if (!geometricNormals) continue;
+      std::vector<bool> inTriangle(coarse.vertexCount(), false);
+      for (const uint32_t v : coarse.triangles) inTriangle[v] = true;
+      for (size_t v = 0; v < coarse.vertexCount(); ++v) {
+        float n[3];
+        std::memcpy(n, &coarse.attributes[0].values[12 * v], 12);
+        const float* p = &coarse.positions[3 * v];
+        ASSERT_NEAR(n[0] * n[0] + n[1] * n[1] + n[2] * n[2], 1.0, 1e-5) << "prefix of " << chunk.offset;
+        if (inTriangle[v])
+          ASSERT_GT(n[0] * p[0] + n[1] * p[1] + n[2] * p[2], 0.0f) << "vertex " << v << ", prefix of " << chunk.offset;
+      }
     }
   }
 }

@@ -134,9 +134,9 @@ TEST(FuzzSeeds, DecoderSeedsDecodeAndCoverEveryTable) {
   for (const auto& entry : std::filesystem::directory_iterator(std::filesystem::path(KDMESH_FUZZ_SEEDS) / "decoder"))
     if (entry.path().extension() == ".kdm") streams.push_back(entry.path());
   std::sort(streams.begin(), streams.end());
-  ASSERT_GE(streams.size(), 7u);
+  ASSERT_GE(streams.size(), 8u);
   bool grid = false, connectivity = false, exactAttribute = false, uniform = false, octahedral = false,
-       labelled = false, nonFinite = false, float64 = false;
+       geometricOctahedral = false, labelled = false, nonFinite = false, float64 = false;
   for (const std::filesystem::path& path : streams) {
     SCOPED_TRACE(path.filename().string());
     std::vector<uint8_t> bytes;
@@ -154,10 +154,12 @@ TEST(FuzzSeeds, DecoderSeedsDecodeAndCoverEveryTable) {
       exactAttribute |= a.quantization.kind == AttributeQuantization::Exact;
       uniform |= a.quantization.kind == AttributeQuantization::Uniform;
       octahedral |= a.quantization.kind == AttributeQuantization::Octahedral;
+      geometricOctahedral |= a.quantization.kind == AttributeQuantization::GeometricOctahedral;
     }
     nonFinite |= std::any_of(c.positions.begin(), c.positions.end(), [](float x) { return !std::isfinite(x); });
   }
-  EXPECT_TRUE(grid && connectivity && exactAttribute && uniform && octahedral && labelled && nonFinite && float64);
+  EXPECT_TRUE(grid && connectivity && exactAttribute && uniform && octahedral && geometricOctahedral && labelled &&
+              nonFinite && float64);
 }
 
 }  // namespace

@@ -50,6 +50,11 @@ struct AttributeQuantization {
     Exact = 0,       // every bit
     Uniform = 1,     // per component, value q of `bits` bits stands for minimum + q · step
     Octahedral = 2,  // a unit vector (3 components) as two `bits`-bit octahedral coordinates
+    // As Octahedral, but coded once the kd-tree is complete, predicted by the
+    // decoded triangles' normals; before that a prefix shows the normals of
+    // its own triangles (docs/FORMAT.md). The encoder's choice for normals
+    // of a complex with triangles.
+    GeometricOctahedral = 3,
   };
   Kind kind = Exact;
   uint8_t bits = 0;
@@ -230,7 +235,9 @@ struct EncodeOptions {
   // 2^-22 of the largest magnitude, where float32 values no longer differ);
   // `normalBits` (2..16) codes a float32 × 3 attribute named `normal` as
   // unit vectors in two octahedral coordinates of that many bits, as web
-  // codecs do (Draco, meshoptimizer). Decoding gives float32 values back.
+  // codecs do (Draco, meshoptimizer); with triangles, after the positions,
+  // predicted from the decoded surface (GeometricOctahedral). Decoding gives
+  // float32 values back.
   int attributeBits = 0;
   int normalBits = 0;
   // Largest chunk payload in bytes. The first chunks are smaller (1 KiB,
