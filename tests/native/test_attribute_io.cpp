@@ -255,8 +255,11 @@ TEST(AttributeIoVtk, PointDataArraysBecomeAttributes) {
   EXPECT_EQ(a[7].type, AttributeType::UInt8);
   EXPECT_EQ(a[7].values, (std::vector<uint8_t>{7, 8, 9}));
   EXPECT_TRUE(r.hasNote("rounded the values of 1 double array to float32")) << joined(r.notes);
-  // The tensor, the lookup table, the 4-tuple FIELD array and the cell data.
-  EXPECT_TRUE(r.hasNote("ignored 4 data arrays")) << joined(r.notes);
+  // The tensor, the lookup table and the 4-tuple FIELD array; the integer
+  // cell data labels the triangle.
+  EXPECT_TRUE(r.hasNote("ignored 3 data arrays")) << joined(r.notes);
+  EXPECT_TRUE(r.hasNote("kept the cell data array 'region' as simplex labels")) << joined(r.notes);
+  EXPECT_EQ(r.complex.labels.triangles, (std::vector<int32_t>{5}));
 }
 
 TEST(AttributeIoVtk, BadPointDataNamesTheLine) {

@@ -387,8 +387,9 @@ TEST(AttributeQuantization, DecodesToTheQuantizedInputOnEveryPrefix) {
         std::memcpy(n, &coarse.attributes[0].values[12 * v], 12);
         const float* p = &coarse.positions[3 * v];
         ASSERT_NEAR(n[0] * n[0] + n[1] * n[1] + n[2] * n[2], 1.0, 1e-5) << "prefix of " << chunk.offset;
-        if (inTriangle[v])
+        if (inTriangle[v]) {
           ASSERT_GT(n[0] * p[0] + n[1] * p[1] + n[2] * p[2], 0.0f) << "vertex " << v << ", prefix of " << chunk.offset;
+        }
       }
     }
   }

@@ -693,8 +693,10 @@ TEST(IoVtk, ReadsUnstructuredGridWithEveryCellKindCrlfAndIgnoredData) {
       "LOOKUP_TABLE default\n"
       "1 2 3 4 5 6\n"
       "CELL_DATA 10\n"
+      "SCALARS quality float\n"
+      "0.5 0.5 0.5 0.5 0.5 0.5 0.5 0.5 0.5 0.5\n"
       "SCALARS region int\n"
-      "1 1 1 1 1 1 1 1 1 2\n";
+      "1 2 3 4 5 6 7 8 9 -10\n";
   for (const std::string& variant : {text, crlf(text)}) {
     const ReadResult r = readText(Format::Vtk, variant);
     ASSERT_TRUE(r.status.ok()) << r.status.message;
@@ -715,7 +717,13 @@ TEST(IoVtk, ReadsUnstructuredGridWithEveryCellKindCrlfAndIgnoredData) {
     EXPECT_EQ(r.complex.attributes[0].name, "s");
     EXPECT_EQ(r.complex.attributes[0].type, AttributeType::Float32);
     EXPECT_EQ(r.complex.attributes[0].values.size(), 24u);
-    EXPECT_TRUE(r.hasNote("ignored 1 data array (cell data")) << joined(r.notes);
+    EXPECT_TRUE(r.hasNote("ignored 1 data array (cell data")) << joined(r.notes);  // quality
+    // The first integer cell array labels each cell's simplices: cells 2
+    // (a line), 3 (the tetrahedron), 1, 4, 5, 6, 8, 9 and 10 in list order.
+    EXPECT_TRUE(r.hasNote("kept the cell data array 'region' as simplex labels")) << joined(r.notes);
+    EXPECT_EQ(r.complex.labels.edges, (std::vector<int32_t>{3, 7, 7}));
+    EXPECT_EQ(r.complex.labels.triangles, (std::vector<int32_t>{2, 5, 5, 6, 6, 6, 9, -10, -10}));
+    EXPECT_EQ(r.complex.labels.tetrahedra, (std::vector<int32_t>{4}));
     // Its double POINTS are decimals that float32 holds: nothing rounded.
     EXPECT_FALSE(r.hasNote("rounded to float32")) << joined(r.notes);
     EXPECT_TRUE(r.hasNote("ignored 1 FIELD")) << joined(r.notes);

@@ -570,15 +570,33 @@ TEST(LabelFiles, ObjMaterials) {
   EXPECT_EQ(back.labels.edges, sphere.labels.edges);
 }
 
+TEST(LabelFiles, VtkCellDataLabelsRoundTrip) {
+  Complex sphere = sphereMesh(8, 10);
+  labelBySlabs(sphere, 3);
+  for (int32_t& label : sphere.labels.triangles) label = label * 1000 - 5;
+  sphere.edges = {0, 1, 2, 3};
+  sphere.labels.edges = {-7, 70000};
+  sphere.points = {4};
+  std::vector<uint8_t> bytes;
+  ASSERT_TRUE(io::writeMemory(io::Format::Vtk, sphere, bytes).ok());
+  io::Notes notes;
+  Complex back;
+  ASSERT_TRUE(io::readMemory(io::Format::Vtk, bytes.data(), bytes.size(), back, notes).ok());
+  ASSERT_EQ(notes.size(), 1u) << joined(notes);
+  EXPECT_EQ(notes[0], "kept the cell data array 'label' as simplex labels");
+  EXPECT_EQ(back.triangles, sphere.triangles);
+  EXPECT_EQ(back.edges, sphere.edges);
+  EXPECT_EQ(back.labels.triangles, sphere.labels.triangles);
+  EXPECT_EQ(back.labels.edges, sphere.labels.edges);
+}
+
 TEST(LabelFiles, FormatsWithoutLabelsRefuse) {
   Complex c = sphereMesh(5, 6);
   labelBySlabs(c, 2);
-  for (const io::Format format : {io::Format::Off, io::Format::Vtk}) {
-    std::vector<uint8_t> bytes;
-    const Status status = io::writeMemory(format, c, bytes);
-    EXPECT_EQ(status.code, ErrorCode::InvalidArgument) << io::formatName(format);
-    EXPECT_NE(status.message.find("labels"), std::string::npos) << status.message;
-  }
+  std::vector<uint8_t> bytes;
+  const Status status = io::writeMemory(io::Format::Off, c, bytes);
+  EXPECT_EQ(status.code, ErrorCode::InvalidArgument);
+  EXPECT_NE(status.message.find("labels"), std::string::npos) << status.message;
 }
 
 }  // namespace

@@ -135,7 +135,8 @@ Status readFile(const std::string& path, Complex& out, Notes& notes,
 bool holdsAttribute(Format format, const VertexAttribute& attribute);
 // Whether files of `format` hold simplex labels exactly: PLY (a `label`
 // property), Medit (element references), TetGen (the region attribute of
-// tetrahedra) and OBJ (usemtl lines whose material names are the labels).
+// tetrahedra), OBJ (usemtl lines whose material names are the labels) and
+// VTK (an integer cell data array).
 // Writers refuse a labelled complex otherwise (InvalidArgument).
 bool holdsLabels(Format format);
 

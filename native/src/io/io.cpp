@@ -315,7 +315,8 @@ const char* formatName(Format format) {
 }
 
 bool holdsLabels(Format format) {
-  return format == Format::Ply || format == Format::Medit || format == Format::TetGen || format == Format::Obj;
+  return format == Format::Ply || format == Format::Medit || format == Format::TetGen || format == Format::Obj ||
+         format == Format::Vtk;
 }
 
 bool holdsAttribute(Format format, const VertexAttribute& a) {
@@ -373,7 +374,7 @@ Status checkAttributesWritable(Format format, const Complex& complex) {
 Status checkLabelsWritable(Format format, const Complex& complex) {
   if (holdsLabels(format) || complex.labels.empty()) return Status::success();
   return Status::error(ErrorCode::InvalidArgument, std::string(formatName(format)) +
-                                                       " cannot hold simplex labels: write PLY, Medit or OBJ to keep them");
+                                                       " cannot hold simplex labels: write PLY, OBJ, Medit, TetGen or VTK to keep them");
 }
 
 Status writeMemory(Format format, const Complex& complex,

@@ -14,8 +14,13 @@
 // case-insensitive. METADATA blocks are skipped. After POINT_DATA n, the
 // arrays of 1 to 4 components (SCALARS, COLOR_SCALARS, VECTORS, NORMALS,
 // TEXTURE_COORDINATES, GLOBAL_IDS, PEDIGREE_IDS and FIELD arrays of n
-// tuples) become vertex attributes; CELL_DATA arrays, TENSORS, lookup
-// tables and FIELD data of the dataset are skipped and counted.
+// tuples) become vertex attributes. After CELL_DATA, the first integer
+// array of one value per cell (SCALARS or FIELD; a region, material or
+// entity id) labels the simplices each cell becomes (a vertex cell's
+// points carry none); other cell arrays, TENSORS, lookup tables and FIELD
+// data of the dataset are skipped and counted.
+//
+// The writer writes labels back as CELL_DATA SCALARS `label` int.
 #include <limits>
 #include <map>
 
@@ -209,6 +214,13 @@ class VtkReader {
     return lineError(tokens_.line(), message);
   }
 
+  // The simplices a cell became: `count` of dimension 1..3 from index
+  // `first` of their list, or none (dimension 0; a vertex cell's points).
+  struct CellSpan {
+    uint8_t dimension;
+    uint32_t first, count;
+  };
+
   // Where the arrays being read belong: the dataset (FIELD before
   // POINT_DATA), its points or its cells.
   enum class Data { None, Points, Cells };
@@ -287,6 +299,8 @@ class VtkReader {
       if (Status status = readDataType(what.c_str(), type); !status.ok()) return status;
     }
     if (attributeName.empty()) attributeName = std::string(name);
+    if (equalsIgnoringCase(keyword, "SCALARS") && takesLabels(type, components, tuples))
+      return readCellLabels(what, std::string(name), tuples);
     const bool keep = data_ == Data::Points && !equalsIgnoringCase(keyword, "LOOKUP_TABLE") &&
                       !equalsIgnoringCase(keyword, "TENSORS");
     return readArray(what, keep ? attributeName : std::string(), type, components, tuples, colour);
@@ -327,6 +341,10 @@ class VtkReader {
       }
       if (!isDataType(type)) {
         return error("FIELD: unknown data type " + quoted(type));
+      }
+      if (takesLabels(type, components, tuples)) {
+        if (Status status = readCellLabels("FIELD array", arrayName, tuples); !status.ok()) return status;
+        continue;
       }
       const bool keep = data_ == Data::Points && tuples == tuples_;
       if (Status status = readArray("FIELD array", keep ? arrayName : std::string(), type, components, tuples, false);
@@ -393,6 +411,60 @@ class VtkReader {
     }
     roundedArrays_ += rounded;
     out_.attributes.push_back(std::move(a));
+    return Status::success();
+  }
+
+  // Whether a cell data array (SCALARS or FIELD) becomes the simplex
+  // labels: the first one of one integer per cell.
+  bool takesLabels(std::string_view typeName, uint64_t components, uint64_t tuples) const {
+    bool rounded, wide;
+    return data_ == Data::Cells && labelArray_.empty() && components == 1 &&
+           tuples == tuples_ && tuples_ == cellCount() &&
+           attributeTypeOf(typeName, rounded, wide) != AttributeType::Float32 && !rounded;
+  }
+
+  uint64_t cellCount() const {
+    uint64_t count = 0;
+    for (const std::vector<CellSpan>& section : cellSpans_) count += section.size();
+    return count;
+  }
+
+  // The values of a cell array taken as labels: each cell's value labels
+  // its simplices. An array with a value beyond int32 is skipped (counted).
+  Status readCellLabels(const std::string& keyword, const std::string& name, uint64_t tuples) {
+    if (Status status = checkBudget(keyword.c_str(), tuples); !status.ok()) return status;
+    std::vector<int32_t> values(size_t(tuples), 0);
+    bool fits = true;
+    std::string_view token;
+    for (uint64_t c = 0; c < tuples; ++c) {
+      if (!tokens_.next(token)) return error("the file ends inside " + keyword + " " + quoted(name));
+      int64_t value;
+      if (!parseInteger(token, value))
+        return error(keyword + " " + quoted(name) + " value " + std::to_string(c) + ": " + quoted(token) +
+                     " is not an integer");
+      fits = fits && value >= INT32_MIN && value <= INT32_MAX;
+      values[size_t(c)] = int32_t(fits ? value : 0);
+    }
+    if (!fits) {
+      ++skippedArrays_;
+      return Status::success();
+    }
+    for (int d = 1; d <= 3; ++d) {
+      const size_t arity = size_t(d) + 1;
+      out_.labels.of(d).assign((d == 1 ? out_.edges : d == 2 ? out_.triangles : out_.tetrahedra).size() / arity, 0);
+    }
+    // Cells are numbered in VTK's order: POLYDATA's vertices, lines,
+    // polygons, then strips, whatever the order of their sections.
+    size_t c = 0;
+    for (const std::vector<CellSpan>& section : cellSpans_)
+      for (const CellSpan& span : section) {
+        if (span.dimension > 0) {
+          std::vector<int32_t>& labels = out_.labels.of(span.dimension);
+          std::fill(labels.begin() + span.first, labels.begin() + span.first + span.count, values[c]);
+        }
+        ++c;
+      }
+    labelArray_ = name;
     return Status::success();
   }
 
@@ -683,7 +755,7 @@ class VtkReader {
         return error("cell " + std::to_string(c) + ": type " + quoted(token) +
                      " is not an integer");
       }
-      if (Status status = addCell(type, cells_, c); !status.ok()) {
+      if (Status status = addCell(type, cells_, c, cellSpans_[0]); !status.ok()) {
         return status;
       }
     }
@@ -705,16 +777,32 @@ class VtkReader {
     if (Status status = readCellArray(name.c_str(), cells); !status.ok()) {
       return status;
     }
+    const int64_t type = polyDataType(keyword);
+    std::vector<CellSpan>& spans =
+        cellSpans_[type == kPolyVertex ? 0 : type == kPolyLine ? 1 : type == kPolygon ? 2 : 3];
     for (uint64_t c = 0; c < cells.count(); ++c) {
-      if (Status status = addCell(polyDataType(keyword), cells, c);
-          !status.ok()) {
+      if (Status status = addCell(type, cells, c, spans); !status.ok()) {
         return status;
       }
     }
     return Status::success();
   }
 
-  Status addCell(int64_t type, const Cells& cells, uint64_t c) {
+  // Adds the simplices of cell c, and where they went to `spans`.
+  Status addCell(int64_t type, const Cells& cells, uint64_t c, std::vector<CellSpan>& spans) {
+    const size_t sizes[4] = {0, out_.edges.size() / 2, out_.triangles.size() / 3, out_.tetrahedra.size() / 4};
+    Status status = addCellSimplices(type, cells, c);
+    if (!status.ok()) return status;
+    const size_t grown[4] = {0, out_.edges.size() / 2 - sizes[1], out_.triangles.size() / 3 - sizes[2],
+                             out_.tetrahedra.size() / 4 - sizes[3]};
+    CellSpan span{0, 0, 0};
+    for (uint8_t d = 1; d <= 3; ++d)
+      if (grown[d] > 0) span = {d, uint32_t(sizes[d]), uint32_t(grown[d])};
+    spans.push_back(span);
+    return Status::success();
+  }
+
+  Status addCellSimplices(int64_t type, const Cells& cells, uint64_t c) {
     const uint32_t* v = cells.connectivity.data() + cells.offsets[c];
     const size_t n =
         static_cast<size_t>(cells.offsets[c + 1] - cells.offsets[c]);
@@ -807,9 +895,11 @@ class VtkReader {
                       "cell types " + types + ")");
     }
     addCountNote(notes, "ignored ", fields_, "FIELD data section", "FIELD data sections", " of the dataset");
+    if (!labelArray_.empty())
+      notes.push_back("kept the cell data array " + quoted(labelArray_) + " as simplex labels");
     addCountNote(notes, "ignored ", skippedArrays_, "data array", "data arrays",
-                 " (cell data, tensors, lookup tables, arrays of more than 4 components or of 64-bit values beyond "
-                 "32 bits, repeated names, or past 15 attributes)");
+                 " (cell data other than one integer label per cell, tensors, lookup tables, arrays of more than 4 "
+                 "components or of 64-bit values beyond 32 bits, repeated names, or past 15 attributes)");
     addCountNote(notes, "rounded the values of ", roundedArrays_, "double array", "double arrays", " to float32");
   }
 
@@ -825,6 +915,10 @@ class VtkReader {
   const bool keepDoubles_;
   bool beyondFloat_ = false;
   Cells cells_;
+  // Where each cell's simplices went, by section in VTK's cell order
+  // (POLYDATA: vertices, lines, polygons, strips; a grid uses the first).
+  std::vector<CellSpan> cellSpans_[4];
+  std::string labelArray_;  // the cell data array taken as labels
   PolygonSplit split_;
   std::map<int64_t, size_t> skippedTypes_;  // at most 16 types named
   size_t skippedOthers_ = 0;                // cells of further types
@@ -889,6 +983,18 @@ Status writeVtk(const Complex& complex, std::vector<uint8_t>& out) {
   for (const auto& group : groups) {
     for (size_t i = 0; i < group.indices.size(); i += group.arity) {
       text.integer(static_cast<uint64_t>(group.type)).endLine();
+    }
+  }
+  if (!complex.labels.empty()) {
+    // One label per cell: a vertex cell's 0, each simplex its own.
+    text.word("CELL_DATA").integer(cells).endLine();
+    text.word("SCALARS label int 1").endLine();
+    text.word("LOOKUP_TABLE default").endLine();
+    for (size_t i = 0; i < complex.points.size(); ++i) text.word("0").endLine();
+    for (int d = 1; d <= 3; ++d) {
+      const std::vector<int32_t>& labels = complex.labels.of(d);
+      const size_t count = groups[d].indices.size() / groups[d].arity;
+      for (size_t i = 0; i < count; ++i) text.word(std::to_string(i < labels.size() ? labels[i] : 0)).endLine();
     }
   }
   if (complex.attributes.empty()) return Status::success();
