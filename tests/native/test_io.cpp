@@ -709,16 +709,17 @@ TEST(IoObj, ReadsVerticesPointsLinesFacesAndCorners) {
   EXPECT_TRUE(r.hasNote("extra columns")) << joined(r.notes);
   EXPECT_TRUE(r.hasNote("'curv' on line 21")) << joined(r.notes);
   // What the OBJ held that the complex does not, counted by keyword.
-  EXPECT_TRUE(r.hasNote("1 group name (g), 1 object name (o)")) << joined(r.notes);
-  EXPECT_TRUE(r.hasNote("1 smoothing group (s), 1 material library (mtllib)")) << joined(r.notes);
+  EXPECT_TRUE(r.hasNote("1 object name (o), 1 smoothing group (s), 1 material library (mtllib)")) << joined(r.notes);
+  EXPECT_TRUE(r.hasNote("ignored 1 group name (g): the materials (usemtl) are the simplex labels")) << joined(r.notes);
   EXPECT_TRUE(r.hasNote("ignored 1 line with unknown keywords")) << joined(r.notes);
   EXPECT_TRUE(r.complex.attributes.empty());
   // The material labels every line and face (all follow its usemtl).
-  EXPECT_TRUE(r.hasNote("1 material of lines and faces as simplex labels, numbered in order of first use: 0 'red'"))
+  EXPECT_TRUE(r.hasNote("1 material (usemtl) of lines and faces as simplex labels, numbered in order of first use: 0 "
+                        "'red'"))
       << joined(r.notes);
   EXPECT_EQ(r.complex.labels.triangles, std::vector<int32_t>(6, 0));
   EXPECT_EQ(r.complex.labels.edges, std::vector<int32_t>(3, 0));
-  EXPECT_EQ(r.notes.size(), 5u) << joined(r.notes);
+  EXPECT_EQ(r.notes.size(), 6u) << joined(r.notes);
 }
 
 TEST(IoObj, BadIndicesAndTokensNameTheLine) {

@@ -570,6 +570,23 @@ TEST(LabelFiles, ObjMaterials) {
   EXPECT_EQ(back.labels.edges, sphere.labels.edges);
 }
 
+TEST(LabelFiles, ObjGroupsWithoutMaterials) {
+  const std::string obj =
+      "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\n"
+      "g wing\nf 1 2 3\ng body part\nf 1 3 4 5\nl 1 5 2\ng wing\nf 2 5 3\n";
+  io::Notes notes;
+  const Complex c = readText(io::Format::Obj, obj, notes);
+  EXPECT_EQ(c.labels.triangles, (std::vector<int32_t>{0, 1, 1, 0}));
+  EXPECT_EQ(c.labels.edges, (std::vector<int32_t>{1, 1}));
+  EXPECT_NE(joined(notes).find("kept the 2 groups (g) of lines and faces as simplex labels, numbered in order of "
+                               "first use: 0 'wing', 1 'body part'"),
+            std::string::npos)
+      << joined(notes);
+  const Complex integers = readText(io::Format::Obj, "v 0 0 0\nv 1 0 0\nv 1 1 0\ng 12\nf 1 2 3\ng -3\nl 1 2\n", notes);
+  EXPECT_EQ(integers.labels.triangles, (std::vector<int32_t>{12}));
+  EXPECT_EQ(integers.labels.edges, (std::vector<int32_t>{-3}));
+}
+
 TEST(LabelFiles, VtkCellDataLabelsRoundTrip) {
   Complex sphere = sphereMesh(8, 10);
   labelBySlabs(sphere, 3);

@@ -114,12 +114,13 @@ struct ReadOptions {
 //   counted in a note. The writer writes each distinct position, texture
 //   coordinate and normal once, and a vertex whose whole corner equals
 //   another vertex's on a v line of its own. Materials (usemtl) label the
-//   lines and faces that follow: by the names' values when every name is a
-//   32-bit decimal integer and no line or face precedes the first usemtl,
-//   otherwise numbered from 0 in order of first use (the unnamed material
-//   of what precedes any usemtl counting as one), with a note listing the
-//   names. The writer writes labels as usemtl lines named by their values.
-//   g, o, s and mtllib lines are counted in a note.
+//   lines and faces that follow, or groups (g) in a file without usemtl:
+//   by the names' values when every name is a 32-bit decimal integer and
+//   no line or face precedes the first name, otherwise numbered from 0 in
+//   order of first use (the unnamed one of what precedes any counting as
+//   one), with a note listing the names. The writer writes labels as
+//   usemtl lines named by their values. o, s and mtllib lines, and g lines
+//   beside usemtl, are counted in a note.
 Status readMemory(Format format, const uint8_t* data, size_t size,
                   Complex& out, Notes& notes, const ReadOptions& options = {});
 Status readFile(const std::string& path, Complex& out, Notes& notes,

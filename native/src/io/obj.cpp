@@ -1,9 +1,9 @@
 // Wavefront OBJ: vertices, points, polylines and faces, with the texture
 // coordinates (vt) and normals (vn) their corners name as the vertex
 // attributes `uv` and `normal`, and the materials (usemtl) of lines and
-// faces as simplex labels (Materials). Groups, objects, smoothing groups
-// and material libraries are not part of a simplicial complex: their lines
-// are counted in a note.
+// faces as simplex labels (SimplexNames), or their groups (g) in a file
+// without materials. Objects, smoothing groups and material libraries are
+// not part of a simplicial complex: their lines are counted in a note.
 #include <charconv>
 #include <cstring>
 #include <type_traits>
@@ -21,7 +21,6 @@ constexpr struct {
   std::string_view keyword, one, many;
 } kSkippedKeywords[] = {
     {"vp", "parameter-space vertex (vp)", "parameter-space vertices (vp)"},
-    {"g", "group name (g)", "group names (g)"},
     {"o", "object name (o)", "object names (o)"},
     {"s", "smoothing group (s)", "smoothing groups (s)"},
     {"mtllib", "material library (mtllib)", "material libraries (mtllib)"},
@@ -51,13 +50,17 @@ size_t minimumIndices(char keyword) {
   }
 }
 
-// The materials (usemtl) of lines and faces as simplex labels. When every
-// material name is a decimal 32-bit integer and no line or face comes
-// before the first usemtl (as writeObj() writes labels), the names are the
-// labels; otherwise materials are numbered from 0 in order of first use,
-// lines and faces before any usemtl counting as one more material.
-class Materials {
+// The names that lines and faces are given, materials (usemtl) or groups
+// (g), as simplex labels. When every name is a decimal 32-bit integer and
+// no line or face comes before the first name (as writeObj() writes
+// labels), the names are the labels; otherwise names are numbered from 0
+// in order of first use, lines and faces before any counting as one more.
+class SimplexNames {
  public:
+  // `one`, `many`: what the names are, singular and plural ("material (usemtl)").
+  SimplexNames(const char* one, const char* many) : one_(one), many_(many) {}
+
+  bool used() const { return used_; }
   void use(std::string_view name) {
     current_ = number(name);
     used_ = true;
@@ -71,7 +74,7 @@ class Materials {
     edges_.resize(out.edges.size() / 2, current_);
     triangles_.resize(out.triangles.size() / 3, current_);
   }
-  // Moves the labels into `out` when the file used materials, with a note
+  // Moves the labels into `out` when the file named simplices, with a note
   // of how they were numbered.
   void finish(Complex& out, Notes& notes) {
     if (!used_) return;
@@ -92,7 +95,7 @@ class Materials {
     for (size_t i = 0; i < std::min(names_.size(), kNamed); ++i)
       list += (i ? ", " : "") + std::to_string(i) + " " + (names_[i].empty() ? "(none)" : quoted(names_[i]));
     if (names_.size() > kNamed) list += ", ...";
-    notes.push_back("kept the " + counted(names_.size(), "material", "materials") +
+    notes.push_back("kept the " + counted(names_.size(), one_, many_) +
                     " of lines and faces as simplex labels, numbered in order of first use: " + list);
   }
 
@@ -105,6 +108,7 @@ class Materials {
   std::unordered_map<std::string, int32_t> numbers_;
   std::vector<std::string> names_;
   std::vector<int32_t> edges_, triangles_;
+  const char *one_, *many_;
   int32_t current_ = -1;
   bool used_ = false, unnamedFirst_ = false;
 };
@@ -324,7 +328,9 @@ Status readObj(const uint8_t* data, size_t size, Complex& out, Notes& notes, boo
   size_t extraColumnLines = 0;
   size_t unknownLines = 0;
   size_t skipped[kSkippedKinds] = {};
-  Materials materials;
+  // Labels: the materials, or the groups of a file without materials.
+  SimplexNames materials("material (usemtl)", "materials (usemtl)"), groups("group (g)", "groups (g)");
+  size_t groupLines = 0;
   std::string firstUnknown;
   bool beyondFloat = false;  // a coordinate that float32 does not hold
   std::string_view keyword;
@@ -348,13 +354,18 @@ Status readObj(const uint8_t* data, size_t size, Complex& out, Notes& notes, boo
       Status status = readIndexLine(scanner, keyword[0], out.vertexCount(), defined, corners, indices);
       if (!status.ok()) return status;
       addSimplices(keyword[0], indices, out, split);
-      if (keyword[0] != 'p') materials.label(out);
-    } else if (keyword == "usemtl") {
-      // The rest of the line is the name (names may hold spaces).
+      if (keyword[0] != 'p') {
+        materials.label(out);
+        groups.label(out);
+      }
+    } else if (keyword == "usemtl" || keyword == "g") {
+      // The rest of the line is the name (names may hold spaces; a group
+      // line may name several groups, which together name the group).
       std::string_view name, more;
-      scanner.nextToken(name);  // none: the unnamed material, as before any usemtl
+      scanner.nextToken(name);  // none: the unnamed one, as before any
       while (scanner.nextToken(more)) name = std::string_view(name.data(), size_t(more.data() + more.size() - name.data()));
-      materials.use(name);
+      (keyword == "g" ? groups : materials).use(name);
+      groupLines += keyword == "g";
     } else if (const size_t kind = skippedKind(keyword); kind < kSkippedKinds) {
       ++skipped[kind];
     } else {
@@ -365,7 +376,10 @@ Status readObj(const uint8_t* data, size_t size, Complex& out, Notes& notes, boo
     }
   }
   settleDoubles(out, beyondFloat, keepDoubles, notes);
-  materials.finish(out, notes);
+  if (materials.used())
+    addCountNote(notes, "ignored ", groupLines, "group name (g)", "group names (g)",
+                 ": the materials (usemtl) are the simplex labels");
+  (materials.used() ? materials : groups).finish(out, notes);
   if (!corners.keys.empty() || defined.uvCount() > 0 || defined.normalCount() > 0)
     makeCornerVertices(defined, corners, out, notes);
   addCountNote(notes, "ignored extra columns (w or colour) on ", extraColumnLines, "vertex line", "vertex lines");
@@ -377,7 +391,7 @@ Status readObj(const uint8_t* data, size_t size, Complex& out, Notes& notes, boo
   if (!lost.empty()) {
     notes.push_back("ignored " + lost +
                     ": kdmesh keeps an OBJ's vertex positions, texture coordinates, normals, faces, lines, points "
-                    "and materials (usemtl) only");
+                    "and materials (usemtl) or groups (g) only");
   }
   if (unknownLines > 0) {
     notes.push_back("ignored " + counted(unknownLines, "line", "lines") + " with unknown keywords (the first: " + firstUnknown +
