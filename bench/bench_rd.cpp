@@ -1,17 +1,20 @@
-// Rate–distortion of progressive decoding: for prefixes of a stream, how far
+// Rate–distortion of progressive decoding: for each prefix of a stream that
+// ends with a chunk (where the decoded model changes), how far
 // each vertex of the complete model is from the vertex that stands for it at
 // that prefix (its ancestor, through the decoder's stable vertex ids), and
 // the symmetric Hausdorff distance between the prefix's and the complete
-// model's surfaces, estimated from 50,000 area-weighted samples of each
-// surface plus its vertices (so it over-estimates by up to the sample
-// spacing); all relative to the bounding-box diagonal.
+// model's surfaces, sampled as Metro does: the largest distance from the
+// vertices and 50,000 area-weighted points of each surface to the other
+// surface (its triangles and vertices), which can miss the farthest point
+// by less than the sample spacing; all relative to the bounding-box
+// diagonal.
 //
-//   kdmesh_bench_rd [--bits B] [--points N] [--placement predicted|centre] [--chunk-bytes N] MODEL
+//   kdmesh_bench_rd [--bits B] [--placement predicted|centre] [--chunk-bytes N] MODEL
 //
 // --placement: where prefixes put vertices whose cells are not yet single
 // grid points (kdmesh::CoarsePlacement; predicted, the default, or centre).
 // --chunk-bytes: the encoder's largest chunk payload (EncodeOptions::chunkBytes):
-// prefixes decode whole chunks, so smaller chunks give a finer curve.
+// smaller chunks give a finer curve.
 //
 // Prints CSV: bytes,vertices,mean_error,max_error,hausdorff (hausdorff is
 // empty for models without triangles).
@@ -65,20 +68,71 @@ std::vector<Point> surfaceSamples(const kdmesh::Complex& c, size_t count, uint32
   return out;
 }
 
-// Nearest-point queries on a point set through a hash grid searched in
-// growing rings of cells.
-class NearestPoint {
+// The closest point to p on triangle abc (Ericson, Real-Time Collision
+// Detection, 5.1.5), and its distance.
+double triangleDistance(const Point& p, const Point& a, const Point& b, const Point& c) {
+  auto sub = [](const Point& x, const Point& y) { return Point{x[0] - y[0], x[1] - y[1], x[2] - y[2]}; };
+  auto dot = [](const Point& x, const Point& y) { return x[0] * y[0] + x[1] * y[1] + x[2] * y[2]; };
+  auto at = [&](const Point& origin, const Point& u, double s, const Point& w, double t) {
+    const Point q{origin[0] + s * u[0] + t * w[0], origin[1] + s * u[1] + t * w[1], origin[2] + s * u[2] + t * w[2]};
+    const Point d = sub(p, q);
+    return std::sqrt(dot(d, d));
+  };
+  const Point ab = sub(b, a), ac = sub(c, a), ap = sub(p, a);
+  const double d1 = dot(ab, ap), d2 = dot(ac, ap);
+  if (d1 <= 0 && d2 <= 0) return at(a, ab, 0, ac, 0);
+  const Point bp = sub(p, b);
+  const double d3 = dot(ab, bp), d4 = dot(ac, bp);
+  if (d3 >= 0 && d4 <= d3) return at(a, ab, 1, ac, 0);
+  const double vc = d1 * d4 - d3 * d2;
+  if (vc <= 0 && d1 >= 0 && d3 <= 0) return at(a, ab, d1 / (d1 - d3), ac, 0);
+  const Point cp = sub(p, c);
+  const double d5 = dot(ab, cp), d6 = dot(ac, cp);
+  if (d6 >= 0 && d5 <= d6) return at(a, ab, 0, ac, 1);
+  const double vb = d5 * d2 - d1 * d6;
+  if (vb <= 0 && d2 >= 0 && d6 <= 0) return at(a, ab, 0, ac, d2 / (d2 - d6));
+  const double va = d3 * d6 - d5 * d4;
+  if (va <= 0 && d4 - d3 >= 0 && d5 - d6 >= 0) {
+    const double w = (d4 - d3) / ((d4 - d3) + (d5 - d6));
+    return at(b, sub(c, b), w, ab, 0);
+  }
+  const double denominator = 1 / (va + vb + vc);
+  return at(a, ab, vb * denominator, ac, vc * denominator);
+}
+
+// Distances to a model's surface: its triangles and its vertices (a vertex
+// in no triangle is a point of the model), through a hash grid of cells
+// about a triangle's size, searched in growing rings.
+class NearestSurface {
  public:
-  NearestPoint(const std::vector<Point>& points, double cell) : points_(points), cell_(cell) {
-    for (size_t i = 0; i < points.size(); ++i) grid_[key(cellOf(points[i]))].push_back(uint32_t(i));
+  NearestSurface(const kdmesh::Complex& c, double diagonal) : c_(c) {
+    const size_t triangles = c.triangles.size() / 3;
+    if (triangles + c.vertexCount() < kFew) return;  // searched without the grid
+    // Cells of twice the mean edge, or of the vertices' spacing without
+    // triangles.
+    double edges = 0;
+    for (size_t t = 0; t < triangles; ++t) edges += length(corner(t, 0), corner(t, 1));
+    const double size = triangles ? 2 * edges / double(triangles) : diagonal / std::cbrt(double(c.vertexCount()));
+    cell_ = std::clamp(size, diagonal / 512, diagonal / 4);
+    for (size_t t = 0; t < triangles; ++t) {
+      std::array<int64_t, 3> lo = cellOf(corner(t, 0)), hi = lo;
+      for (int k = 1; k < 3; ++k) {
+        const std::array<int64_t, 3> q = cellOf(corner(t, k));
+        for (int a = 0; a < 3; ++a) lo[a] = std::min(lo[a], q[a]), hi[a] = std::max(hi[a], q[a]);
+      }
+      for (int64_t x = lo[0]; x <= hi[0]; ++x)
+        for (int64_t y = lo[1]; y <= hi[1]; ++y)
+          for (int64_t z = lo[2]; z <= hi[2]; ++z) grid_[key({x, y, z})].triangles.push_back(uint32_t(t));
+    }
+    for (size_t v = 0; v < c.vertexCount(); ++v) grid_[key(cellOf(vertex(v)))].vertices.push_back(uint32_t(v));
   }
 
   double distance(const Point& p) const {
     double best = INFINITY;
-    if (points_.size() < 4096) {  // few points (coarse prefixes): far apart, no grid
-      for (const Point& q : points_)
-        best = std::min(best, std::sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
-                                        (p[2] - q[2]) * (p[2] - q[2])));
+    if (c_.triangles.size() / 3 + c_.vertexCount() < kFew) {
+      for (size_t t = 0; t < c_.triangles.size() / 3; ++t)
+        best = std::min(best, triangleDistance(p, corner(t, 0), corner(t, 1), corner(t, 2)));
+      for (size_t v = 0; v < c_.vertexCount(); ++v) best = std::min(best, length(p, vertex(v)));
       return best;
     }
     const std::array<int64_t, 3> c = cellOf(p);
@@ -89,31 +143,41 @@ class NearestPoint {
             if (std::max({std::llabs(dx), std::llabs(dy), std::llabs(dz)}) != ring) continue;
             const auto found = grid_.find(key({c[0] + dx, c[1] + dy, c[2] + dz}));
             if (found == grid_.end()) continue;
-            for (const uint32_t i : found->second) {
-              const Point& q = points_[i];
-              best = std::min(best, std::sqrt((p[0] - q[0]) * (p[0] - q[0]) + (p[1] - q[1]) * (p[1] - q[1]) +
-                                              (p[2] - q[2]) * (p[2] - q[2])));
-            }
+            for (const uint32_t t : found->second.triangles)
+              best = std::min(best, triangleDistance(p, corner(t, 0), corner(t, 1), corner(t, 2)));
+            for (const uint32_t v : found->second.vertices) best = std::min(best, length(p, vertex(v)));
           }
-      // Cells beyond this ring are at least ring * cell away.
+      // What lies beyond this ring is at least ring * cell away.
       if (best <= double(ring) * cell_) break;
     }
     return best;
   }
 
  private:
+  static constexpr size_t kFew = 64;  // triangles and vertices searched one by one
+  struct Cell {
+    std::vector<uint32_t> triangles, vertices;
+  };
+  Point vertex(size_t v) const {
+    return {c_.positions[3 * v], c_.positions[3 * v + 1], c_.positions[3 * v + 2]};
+  }
+  Point corner(size_t t, int k) const { return vertex(c_.triangles[3 * t + size_t(k)]); }
+  static double length(const Point& a, const Point& b) {
+    return std::sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+  }
   std::array<int64_t, 3> cellOf(const Point& p) const {
     return {int64_t(std::floor(p[0] / cell_)), int64_t(std::floor(p[1] / cell_)), int64_t(std::floor(p[2] / cell_))};
   }
   static uint64_t key(const std::array<int64_t, 3>& c) {
     return uint64_t(c[0] * 73856093) ^ uint64_t(c[1] * 19349663) ^ uint64_t(c[2] * 83492791);
   }
-  const std::vector<Point>& points_;
+  const kdmesh::Complex& c_;
   double cell_;
-  std::unordered_map<uint64_t, std::vector<uint32_t>> grid_;
+  std::unordered_map<uint64_t, Cell> grid_;
 };
 
-double directedHausdorff(const std::vector<Point>& from, const NearestPoint& to) {
+// The largest distance from the samples to the surface.
+double directedHausdorff(const std::vector<Point>& from, const NearestSurface& to) {
   double worst = 0;
   for (const Point& p : from) worst = std::max(worst, to.distance(p));
   return worst;
@@ -122,14 +186,13 @@ double directedHausdorff(const std::vector<Point>& from, const NearestPoint& to)
 }  // namespace
 
 int main(int argc, char** argv) {
-  int bits = 12, samples = 40;
+  int bits = 12;
   size_t chunkBytes = kdmesh::EncodeOptions{}.chunkBytes;
   kdmesh::DecoderOptions decoding;
   std::string path;
   for (int i = 1; i < argc; ++i) {
     const std::string arg = argv[i];
     if (arg == "--bits" && i + 1 < argc) bits = std::atoi(argv[++i]);
-    else if (arg == "--points" && i + 1 < argc) samples = std::max(2, std::atoi(argv[++i]));
     else if (arg == "--chunk-bytes" && i + 1 < argc) chunkBytes = size_t(std::max(64, std::atoi(argv[++i])));
     else if (arg == "--placement" && i + 1 < argc) {
       const std::string placement = argv[++i];
@@ -138,7 +201,7 @@ int main(int argc, char** argv) {
           placement == "centre" ? kdmesh::CoarsePlacement::CellCentre : kdmesh::CoarsePlacement::Predicted;
     }
     else if (arg == "--help" || arg == "-h") {
-      std::printf("usage: kdmesh_bench_rd [--bits B] [--points N] [--placement predicted|centre] [--chunk-bytes N] MODEL\n");
+      std::printf("usage: kdmesh_bench_rd [--bits B] [--placement predicted|centre] [--chunk-bytes N] MODEL\n");
       return 0;
     } else path = arg;
   }
@@ -167,15 +230,15 @@ int main(int argc, char** argv) {
   const bool surfaces = !final.triangles.empty();
   const size_t kSamples = 50000;
   const std::vector<Point> finalSamples = surfaces ? surfaceSamples(final, kSamples, 1) : std::vector<Point>{};
-  const double cell = diagonal / 256;
-  const NearestPoint nearFinal(finalSamples, cell);
+  const NearestSurface nearFinal(final, diagonal);
 
   std::printf("bytes,vertices,mean_error,max_error,hausdorff\n");
-  const double first = double(kdmesh::kMaxHeaderBytes + 16), last = double(bytes.size());
-  for (int s = 0; s < samples; ++s) {
-    const size_t cut = size_t(std::llround(first * std::pow(last / first, double(s) / (samples - 1))));
-    kdmesh::Decoder decoder(decoding);
-    if (!decoder.push(bytes.data(), cut).ok()) bench::fail("prefix does not decode");
+  kdmesh::Decoder decoder(decoding);
+  size_t cut = 0;
+  for (const kdmesh::ChunkInfo& chunk : full.chunks()) {
+    const size_t end = size_t(chunk.offset) + chunk.payloadBytes + chunk.frameBytes;
+    if (!decoder.push(bytes.data() + cut, end - cut).ok()) bench::fail("prefix does not decode");
+    cut = end;
     const kdmesh::Complex prefix = decoder.snapshot();
     const uint32_t count = uint32_t(prefix.vertexCount());
     if (count == 0) continue;
@@ -195,7 +258,7 @@ int main(int argc, char** argv) {
     std::string hausdorff;
     if (surfaces) {
       const std::vector<Point> prefixSamples = surfaceSamples(prefix, kSamples, 2);
-      const NearestPoint nearPrefix(prefixSamples, cell);
+      const NearestSurface nearPrefix(prefix, diagonal);
       const double h = std::max(directedHausdorff(prefixSamples, nearFinal), directedHausdorff(finalSamples, nearPrefix));
       char text[32];
       std::snprintf(text, sizeof text, "%.6g", h / diagonal);

@@ -121,7 +121,7 @@ if [ "$quick" = 0 ]; then
     plot="$plot $name-${b}bit=$rd/$name.csv$draco"
     echo "- $name ($b bits): $(sed -n 2p "$rd/$name.csv" | cut -d, -f2) vertex after $(sed -n 2p "$rd/$name.csv" | cut -d, -f1) bytes;" \
       "mean error 1 % of the diagonal after $(awk -F, 'NR > 1 && $3 <= 0.01 { print $1; exit }' "$rd/$name.csv") bytes," \
-      "sampled Hausdorff 1 % after $(awk -F, 'NR > 1 && $5 != "" && $5 <= 0.01 { print $1; exit }' "$rd/$name.csv") bytes," \
+      "Hausdorff 1 % after $(awk -F, 'NR > 1 && $5 != "" && $5 <= 0.01 { print $1; exit }' "$rd/$name.csv") bytes," \
       "of $(tail -n 1 "$rd/$name.csv" | cut -d, -f1)"
   done
   # shellcheck disable=SC2086
