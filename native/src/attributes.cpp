@@ -363,28 +363,17 @@ void AttributeCoder::mirrorOctahedral(const Layout& layout, uint32_t* images) {
   images[1] = uint32_t((mirroredV + top) / 2);
 }
 
-void AttributeCoder::unitNormal(const double* sums, double* out) {
-  const double length = std::sqrt(sums[0] * sums[0] + sums[1] * sums[1] + sums[2] * sums[2]);
-  for (int c = 0; c < 3; ++c) out[c] = length > 0 ? sums[c] / length : 0.0;
-}
-
-uint8_t AttributeCoder::agreementSpread(const double* sums) {
-  const double length = std::sqrt(sums[0] * sums[0] + sums[1] * sums[1] + sums[2] * sums[2]);
-  const double agreement = sums[3] > 0 ? length / sums[3] : 0;
-  return agreement >= 0.9 ? 0 : agreement >= 0.7 ? 1 : agreement >= 0.5 ? 3 : 6;
-}
-
 void AttributeCoder::holdDirection(size_t a, const double* direction, uint8_t* values) const {
   uint32_t images[4];
   encodeOctahedral(direction, layouts_[a].top, images);
   store(layouts_[a], values, images);
 }
 
-void triangleAreaVectors(const SimplexStore& store, const std::vector<float>& positions, std::vector<double>& out) {
+void triangleNormals(const SimplexStore& store, const std::vector<float>& positions, std::vector<double>& out) {
   const size_t n = positions.size() / 3;
   out.assign(n * 4, 0.0);
   for (uint32_t vertex = 0; vertex < n; ++vertex) {
-    double* sum = &out[size_t(vertex) * 4];
+    double sum[3] = {0, 0, 0}, lengths = 0;
     const float* p = &positions[size_t(vertex) * 3];
     store.forEachIncident(2, vertex, [&](uint32_t triangle, uint32_t position) {
       // The two vertices that follow this one in the triangle's winding.
@@ -396,9 +385,21 @@ void triangleAreaVectors(const SimplexStore& store, const std::vector<float>& po
       const double w[3] = {double(b[0]) - p[0], double(b[1]) - p[1], double(b[2]) - p[2]};
       const double area[3] = {u[1] * w[2] - u[2] * w[1], u[2] * w[0] - u[0] * w[2], u[0] * w[1] - u[1] * w[0]};
       for (int c = 0; c < 3; ++c) sum[c] += area[c];
-      sum[3] += std::sqrt(area[0] * area[0] + area[1] * area[1] + area[2] * area[2]);
+      lengths += std::sqrt(area[0] * area[0] + area[1] * area[1] + area[2] * area[2]);
     });
+    const double length = std::sqrt(sum[0] * sum[0] + sum[1] * sum[1] + sum[2] * sum[2]);
+    double* normal = &out[size_t(vertex) * 4];
+    for (int c = 0; c < 3; ++c) normal[c] = length > 0 ? sum[c] / length : 0.0;
+    normal[3] = lengths > 0 ? length / lengths : 0.0;
   }
+}
+
+void earlierNeighbours(const SimplexStore& store, uint32_t vertex, std::vector<uint32_t>& out) {
+  out.clear();
+  store.forEachIncident(1, vertex, [&](uint32_t edge, uint32_t position) {
+    const uint32_t other = store.vertices(1, edge)[1 - position];
+    if (other < vertex) out.push_back(other);
+  });
 }
 
 void AttributeCoder::octahedralImages(const Layout& layout, const double* direction, uint32_t* out) {

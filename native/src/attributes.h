@@ -83,13 +83,19 @@ Parsed readAttributeTable(const uint8_t* in, size_t available, uint8_t count, st
 std::vector<std::vector<uint8_t>> heldValues(const std::vector<VertexAttribute>& attributes,
                                              const std::vector<AttributeQuantization>& quantization);
 
-// For each vertex, the sum of the oriented area vectors of its triangles
-// in `store` and the sum of their lengths, over `positions` (3 floats per
-// vertex): 4 doubles per vertex in `out`, the sums of geometric octahedral
-// predictions. Each vertex walks its own incidence list (docs/FORMAT.md),
-// so encoder and decoder, which hold the same store, add in the same order
-// and agree to the bit.
-void triangleAreaVectors(const SimplexStore& store, const std::vector<float>& positions, std::vector<double>& out);
+// For each vertex, over `positions` (3 floats per vertex), the unit normal
+// of its triangles in `store` (the sum S of their oriented area vectors
+// over its length; zero without triangles) and how far they agree on it
+// (|S| over the sum of the vectors' lengths; 0 without triangles): 4
+// doubles per vertex in `out`, what geometric octahedral predictions start
+// from. Each vertex walks its own incidence list (docs/FORMAT.md), so
+// encoder and decoder, which hold the same store, add in the same order and
+// agree to the bit.
+void triangleNormals(const SimplexStore& store, const std::vector<float>& positions, std::vector<double>& out);
+
+// The other ends of `vertex`'s edges in `store` with lower ids (whose
+// values after the kd-tree come first), in edge list order, in `out`.
+void earlierNeighbours(const SimplexStore& store, uint32_t vertex, std::vector<uint32_t>& out);
 
 class AttributeCoder {
  public:
@@ -156,24 +162,21 @@ class AttributeCoder {
     }
   }
 
-  // A geometric octahedral attribute's prediction for `vertex` from the
-  // sums of triangleAreaVectors() (4 per vertex): the unit normal of its
-  // triangles (their area vectors' sum; none give +z), moved by
-  // kNeighbourErrorShare of the mean error of that normal at its
-  // neighbours whose values are known (`decoded`: their held values by
-  // valuesOf(id)), since the quantization of the positions tilts nearby
-  // normals alike; trusted as far as its triangles agree (the sum's length
-  // against the sum of lengths).
+  // A geometric octahedral attribute's prediction for `vertex` from
+  // triangleNormals() (4 per vertex): the unit normal of its triangles
+  // (none give +z), moved by kNeighbourErrorShare of the mean error of that
+  // normal at its neighbours whose values are known (`decoded`: their held
+  // values by valuesOf(id)), since the quantization of the positions tilts
+  // nearby normals alike; trusted as far as its triangles agree.
   template <class ValuesOf>
-  void predictFromTriangles(size_t a, const std::vector<double>& sums, uint32_t vertex,
+  void predictFromTriangles(size_t a, const std::vector<double>& normals, uint32_t vertex,
                             const std::vector<uint32_t>& decoded, ValuesOf&& valuesOf, Prediction& out) const {
-    double direction[3];
-    unitNormal(&sums[size_t(vertex) * 4], direction);
+    const double* own = &normals[size_t(vertex) * 4];
+    double direction[3] = {own[0], own[1], own[2]};
     if (!decoded.empty()) {
       double error[3] = {0, 0, 0};
       for (const uint32_t n : decoded) {
-        double predicted[3];
-        unitNormal(&sums[size_t(n) * 4], predicted);
+        const double* predicted = &normals[size_t(n) * 4];
         const uint8_t* values = valuesOf(n);
         for (int c = 0; c < 3; ++c) {
           float held;
@@ -185,7 +188,7 @@ class AttributeCoder {
       for (int c = 0; c < 3; ++c) direction[c] += share * error[c];
     }
     octahedralImages(layouts_[a], direction, out.images);
-    std::fill(out.spread, out.spread + 4, agreementSpread(&sums[size_t(vertex) * 4]));
+    std::fill(out.spread, out.spread + 4, agreementSpread(own[3]));
   }
   // Writes to `values` the normal of attribute `a` that `direction` stands
   // for, as a decoder holds it (the quantized unit vector).
@@ -258,11 +261,11 @@ class AttributeCoder {
   static int lengthClass(int length) { return length == 0 ? 0 : length <= 2 ? 1 : length <= 5 ? 2 : 3; }
   static void addNormal(const uint8_t* values, double* sum);
   static constexpr double kNeighbourErrorShare = 0.375;
-  // The unit vector of sums[0..3) (zero stays zero).
-  static void unitNormal(const double* sums, double* out);
   // A spread (as lengthClass() reads it) for how far a vertex's triangles
-  // agree on its normal (4 sums of triangleAreaVectors()).
-  static uint8_t agreementSpread(const double* sums);
+  // agree on its normal (triangleNormals()).
+  static uint8_t agreementSpread(double agreement) {
+    return agreement >= 0.9 ? 0 : agreement >= 0.7 ? 1 : agreement >= 0.5 ? 3 : 6;
+  }
   static void octahedralImages(const Layout& layout, const double* direction, uint32_t* out);
 
   // Codes a `bits`-bit difference (two's complement); returns it and the

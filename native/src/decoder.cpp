@@ -86,10 +86,10 @@ struct Decoder::State {
   std::vector<uint32_t> neighbours;  // of the vertex whose attributes are decoded
   // Attributes coded after the kd-tree (GeometricOctahedral): the next
   // vertex whose values come, the last one's id + 1 once all have (vertex
-  // 0's are in the table), and triangleAreaVectors() of the final complex.
+  // 0's are in the table), and triangleNormals() of the final complex.
   bool afterGeometry = false;
   uint32_t nextAfterGeometry = 1;
-  std::vector<double> triangleSums;
+  std::vector<double> triangleNormalsByVertex;
   // Simplex labels: the table after the attribute table; the store holds
   // indices into it.
   std::vector<int32_t> labelTable;
@@ -120,9 +120,8 @@ struct Decoder::State {
            (!named || cells.empty());
   }
 
-  bool complete() const {
-    return kdTreeComplete() && (!afterGeometry || nextAfterGeometry >= header.vertexCount);
-  }
+  bool complete() const { return kdTreeComplete() && afterGeometryComplete(); }
+  bool afterGeometryComplete() const { return !afterGeometry || nextAfterGeometry >= header.vertexCount; }
 
   Status fail(Status status) {
     error = status;
@@ -172,10 +171,11 @@ struct Decoder::State {
       return Status::error(ErrorCode::CorruptChunk, where + ": checksum mismatch");
     coder.start(chunk + frameBytes, frame.payloadBytes);
     for (uint32_t left = frame.splitCount; left > 0;) {
-      if (complete())
+      const bool treeComplete = kdTreeComplete();
+      if (treeComplete && afterGeometryComplete())
         return Status::error(ErrorCode::CorruptChunk,
                              where + ": more splits than the kd-tree has cells");
-      if (kdTreeComplete()) {
+      if (treeComplete) {
         decodeAfterGeometry();
         --left;
         continue;
@@ -296,39 +296,31 @@ struct Decoder::State {
   // kd-tree, against its triangles' normal; the first call finds the
   // normals of all vertices.
   void decodeAfterGeometry() {
-    if (triangleSums.empty()) {
-      std::vector<float> positions(size_t(nextVertex) * 3);
-      forEachCurrentCell([&](const Cell& cell, int cellLevel) {
-        for (int a = 0; a < 3; ++a) {
-          uint32_t lo, hi;
-          cellRange(cell, cellLevel, a, lo, hi);
-          positions[size_t(cell.vertex) * 3 + size_t(a)] = dequantizer->position(a, lo, hi);
-        }
-      });
-      if (connectivity)
-        triangleAreaVectors(store, positions, triangleSums);
-      else
-        triangleSums.assign(positions.size() / 3 * 4, 0.0);
+    std::vector<double>& normals = triangleNormalsByVertex;
+    if (normals.empty()) {
+      if (connectivity) {
+        std::vector<float> positions;
+        cellPositions(positions);
+        triangleNormals(store, positions, normals);
+      } else {
+        normals.assign(size_t(nextVertex) * 4, 0.0);
+      }
     }
     const uint32_t vertex = nextAfterGeometry++;
     neighbours.clear();  // those of lower ids, decoded
-    if (connectivity)
-      store.forEachIncident(1, vertex, [&](uint32_t edge, uint32_t position) {
-        const uint32_t n = store.vertices(1, edge)[1 - position];
-        if (n < vertex) neighbours.push_back(n);
-      });
+    if (connectivity) earlierNeighbours(store, vertex, neighbours);
     for (size_t a = 0; a < attributes.size(); ++a) {
       if (!attributeCoder->codedAfterGeometry(a)) continue;
       const size_t bytes = attributes[a].valueBytes();
       const uint8_t* values = attributes[a].values.data();
       AttributeCoder::Prediction prediction;
       attributeCoder->predictFromTriangles(
-          a, triangleSums, vertex, neighbours, [&](uint32_t n) { return values + size_t(n) * bytes; }, prediction);
+          a, normals, vertex, neighbours, [&](uint32_t n) { return values + size_t(n) * bytes; }, prediction);
       const double before = coder.cost();
       attributeCoder->code(coder, a, prediction, attributes[a].values.data() + size_t(vertex) * bytes);
       cost.attributeBits[a] += coder.cost() - before;
     }
-    if (nextAfterGeometry == header.vertexCount) triangleSums = {};
+    if (nextAfterGeometry == header.vertexCount) normals = {};
   }
 
   void refineSingles(size_t begin, size_t end) {
@@ -490,6 +482,19 @@ struct Decoder::State {
     for (size_t i = 0; i < singles.size(); ++i)
       visit(singles[i], i >= singleCursor && i < singleLevelEnd ? level : level + 1);
     for (const Cell& c : newSingles) visit(c, level + 1);
+  }
+
+  // Each vertex at its cell's centre (once its cell is a grid point, where
+  // it is), by vertex id (streams whose vertices have ids).
+  void cellPositions(std::vector<float>& positions) const {
+    positions.resize(size_t(nextVertex) * 3);
+    forEachCurrentCell([&](const Cell& cell, int cellLevel) {
+      for (int a = 0; a < 3; ++a) {
+        uint32_t lo, hi;
+        cellRange(cell, cellLevel, a, lo, hi);
+        positions[size_t(cell.vertex) * 3 + size_t(a)] = dequantizer->position(a, lo, hi);
+      }
+    });
   }
 
   // Cells of the current level; once complete, the vertices.
@@ -659,14 +664,7 @@ struct Decoder::State {
         holdTriangleNormals(out, attributeCount);
         return;
       }
-      out.positions.resize(size_t(nextVertex) * 3);
-      forEachCurrentCell([&](const Cell& cell, int cellLevel) {
-        for (int a = 0; a < 3; ++a) {
-          uint32_t lo, hi;
-          cellRange(cell, cellLevel, a, lo, hi);
-          out.positions[size_t(cell.vertex) * 3 + size_t(a)] = dequantizer->position(a, lo, hi);
-        }
-      });
+      cellPositions(out.positions);
       if (!finished) {
         appendSimplices(out);
         holdTriangleNormals(out, attributeCount);

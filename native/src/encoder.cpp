@@ -1,7 +1,6 @@
 // The encoder: quantize, order the vertices along the kd-tree, then code the
 // count of every cell split, level by level, into checksummed chunks.
 #include <algorithm>
-#include <cmath>
 #include <cstring>
 #include <string>
 
@@ -469,21 +468,17 @@ EncodeResult encodeStream(const Complex& complex, const EncodeOptions& options, 
         const uint32_t c = coords[size_t(inputOfId[id]) * 3 + size_t(a)];
         positions[size_t(id) * 3 + size_t(a)] = dequantizer.position(a, c, c);
       }
-    std::vector<double> sums;
-    triangleAreaVectors(forward, positions, sums);
+    std::vector<double> normals;
+    triangleNormals(forward, positions, normals);
     std::vector<uint32_t> decoded;  // neighbours of lower ids
     for (uint32_t id = 1; id < header.vertexCount; ++id) {
-      decoded.clear();
-      forward.forEachIncident(1, id, [&](uint32_t edge, uint32_t position) {
-        const uint32_t n = forward.vertices(1, edge)[1 - position];
-        if (n < id) decoded.push_back(n);
-      });
+      earlierNeighbours(forward, id, decoded);
       for (size_t a = 0; a < complex.attributes.size(); ++a) {
         if (!attributeCoder.codedAfterGeometry(a)) continue;
         const size_t bytes = complex.attributes[a].valueBytes();
         AttributeCoder::Prediction prediction;
         attributeCoder.predictFromTriangles(
-            a, sums, id, decoded, [&](uint32_t n) { return held[a].data() + size_t(inputOfId[n]) * bytes; },
+            a, normals, id, decoded, [&](uint32_t n) { return held[a].data() + size_t(inputOfId[n]) * bytes; },
             prediction);
         uint8_t coded[16];
         std::memcpy(coded, held[a].data() + size_t(inputOfId[id]) * bytes, bytes);

@@ -15,7 +15,7 @@ import { cli } from '../js/fixtures.mjs';
 import { writeTestScene, readGlb } from '../js/gltf-fixtures.mjs';
 
 const models = mkdtempSync(join(tmpdir(), 'kdmesh-gltf-'));
-let session, browser, base, expected;
+let served, browser, base, expected;
 
 const testPage = `<!doctype html><meta charset="utf-8"><link rel="icon" href="data:,">
 <script type="importmap">{ "imports": { "three": "./vendor/three/build/three.module.js",
@@ -57,12 +57,12 @@ before(async () => {
   const view = json.bufferViews[json.meshes[0].primitives[0].extensions.KDMESH_progressive_compression.bufferView];
   const decoded = await decode(bin.subarray(view.byteOffset, view.byteOffset + view.byteLength));
   expected = modelChecksum({ ...decoded, points: new Uint32Array(0) });
-  session = await serveAndLaunch(models);
-  ({ base, browser } = session);
+  served = await serveAndLaunch(models);
+  ({ base, browser } = served);
 });
 
 after(async () => {
-  await session?.close();
+  await served?.close();
   rmSync(models, { recursive: true, force: true });
 });
 

@@ -15,7 +15,7 @@ import { modelChecksum } from '../../web/model-checksum.js';
 import { root, cli, colouredTorus, writePly } from '../js/fixtures.mjs';
 
 const models = mkdtempSync(join(tmpdir(), 'kdmesh-loader-'));
-let session, browser, base, expected, coloured;
+let served, browser, base, expected, coloured;
 
 // A page with three.js and kdmesh/three in its import map, as the viewer has.
 const testPage = `<!doctype html><meta charset="utf-8"><link rel="icon" href="data:,">
@@ -36,12 +36,12 @@ before(async () => {
   writePly(join(models, 'coloured.ply'), colouredTorus());
   execFileSync(cli, ['encode', join(models, 'coloured.ply'), '-o', join(models, 'coloured.kdm'), '--bits', '12', '--chunk-bytes', '1024', '-q']);
   coloured = await decode(readFileSync(join(models, 'coloured.kdm')));
-  session = await serveAndLaunch(models);
-  ({ base, browser } = session);
+  served = await serveAndLaunch(models);
+  ({ base, browser } = served);
 });
 
 after(async () => {
-  await session?.close();
+  await served?.close();
   rmSync(models, { recursive: true, force: true });
 });
 

@@ -14,7 +14,7 @@ import { writeTestScene } from '../js/gltf-fixtures.mjs';
 
 const models = mkdtempSync(join(tmpdir(), 'kdmesh-browser-'));
 const screenshots = join(root, 'build', 'screenshots');
-let session, browser, base;
+let served, browser, base;
 
 before(async () => {
   execFileSync(cli, ['encode', join(root, 'build', 'models', 'dragon_vrip.ply'), '-o', join(models, 'dragon.kdm'), '--bits', '12', '-q']);
@@ -39,12 +39,12 @@ before(async () => {
   writeTestScene(join(models, 'input-scene.glb'));
   execFileSync(cli, ['encode', join(models, 'input-scene.glb'), '-o', join(models, 'scene.kdm.glb'), '-q']);
   execFileSync('mkdir', ['-p', screenshots]);
-  session = await serveAndLaunch(models);
-  ({ base, browser } = session);
+  served = await serveAndLaunch(models);
+  ({ base, browser } = served);
 });
 
 after(async () => {
-  await session?.close();
+  await served?.close();
   rmSync(models, { recursive: true, force: true });
 });
 

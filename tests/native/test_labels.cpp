@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "complexes.h"
+#include "io_test_support.h"
 #include "container.h"
 #include "crc32.h"
 #include "kdmesh/io.h"
@@ -76,6 +77,16 @@ void labelBySlabs(Complex& c, int regions) {
       labels.push_back(slab(x / float(d + 1), lo, hi, regions));
     }
   }
+}
+
+// A sphere with `edges` labelled by 3 slabs, the triangles' labels far
+// from 0 and negative (-5, 995, 1995): what writers must keep as they are.
+Complex sphereInSlabs(int rings, int segments, std::vector<uint32_t> edges) {
+  Complex sphere = sphereMesh(rings, segments);
+  sphere.edges = std::move(edges);
+  labelBySlabs(sphere, 3);
+  for (int32_t& label : sphere.labels.triangles) label = label * 1000 - 5;
+  return sphere;
 }
 
 EncodeOptions exactOptions(size_t chunkBytes = 256) {
@@ -534,9 +545,8 @@ TEST(LabelFiles, TetgenRegionAttribute) {
   EXPECT_EQ(joined(notes).find("region"), std::string::npos) << joined(notes);
 }
 
-// OBJ materials (usemtl) label lines and faces: named materials are
-// numbered in order of first use, with a note; integer names are the labels
-// themselves, as the writer names them.
+// OBJ materials (usemtl) label lines and faces, those before any usemtl
+// counting as one more; the writer names materials by the labels.
 TEST(LabelFiles, ObjMaterials) {
   const std::string obj =
       "mtllib scene.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\n"
@@ -550,61 +560,52 @@ TEST(LabelFiles, ObjMaterials) {
   EXPECT_NE(joined(notes).find("1 material library (mtllib)"), std::string::npos) << joined(notes);
   EXPECT_EQ(joined(notes).find("material use"), std::string::npos) << joined(notes);
 
-  const Complex integers =
-      readText(io::Format::Obj, "v 0 0 0\nv 1 0 0\nv 1 1 0\nusemtl -7\nf 1 2 3\nusemtl 40\nl 1 2\n", notes);
-  EXPECT_EQ(integers.labels.triangles, (std::vector<int32_t>{-7}));
-  EXPECT_EQ(integers.labels.edges, (std::vector<int32_t>{40}));
-
-  Complex sphere = sphereMesh(5, 6);
-  sphere.edges = {0, 1, 1, 2};
-  labelBySlabs(sphere, 3);
-  for (int32_t& label : sphere.labels.triangles) label = label * 1000 - 5;
-  std::vector<uint8_t> bytes;
-  ASSERT_TRUE(io::writeMemory(io::Format::Obj, sphere, bytes).ok());
-  io::Notes again;
-  Complex back;
-  ASSERT_TRUE(io::readMemory(io::Format::Obj, bytes.data(), bytes.size(), back, again).ok());
-  EXPECT_TRUE(again.empty()) << joined(again);
-  EXPECT_EQ(back.triangles, sphere.triangles);
-  EXPECT_EQ(back.labels.triangles, sphere.labels.triangles);
-  EXPECT_EQ(back.labels.edges, sphere.labels.edges);
+  const Complex sphere = sphereInSlabs(5, 6, {0, 1, 1, 2});
+  const ReadResult back = writeThenRead(io::Format::Obj, sphere);
+  ASSERT_TRUE(back.status.ok()) << back.status.message;
+  EXPECT_TRUE(back.notes.empty()) << joined(back.notes);
+  EXPECT_EQ(back.complex.triangles, sphere.triangles);
+  EXPECT_EQ(back.complex.labels.triangles, sphere.labels.triangles);
+  EXPECT_EQ(back.complex.labels.edges, sphere.labels.edges);
 }
 
-TEST(LabelFiles, ObjGroupsWithoutMaterials) {
-  const std::string obj =
-      "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\n"
-      "g wing\nf 1 2 3\ng body part\nf 1 3 4 5\nl 1 5 2\ng wing\nf 2 5 3\n";
-  io::Notes notes;
-  const Complex c = readText(io::Format::Obj, obj, notes);
-  EXPECT_EQ(c.labels.triangles, (std::vector<int32_t>{0, 1, 1, 0}));
-  EXPECT_EQ(c.labels.edges, (std::vector<int32_t>{1, 1}));
-  EXPECT_NE(joined(notes).find("kept the 2 groups (g) of lines and faces as simplex labels, numbered in order of "
-                               "first use: 0 'wing', 1 'body part'"),
-            std::string::npos)
-      << joined(notes);
-  const Complex integers = readText(io::Format::Obj, "v 0 0 0\nv 1 0 0\nv 1 1 0\ng 12\nf 1 2 3\ng -3\nl 1 2\n", notes);
-  EXPECT_EQ(integers.labels.triangles, (std::vector<int32_t>{12}));
-  EXPECT_EQ(integers.labels.edges, (std::vector<int32_t>{-3}));
+// Materials, or groups in a file without materials, name the labels: in
+// order of first use, or as their values when all names are integers.
+TEST(LabelFiles, ObjMaterialsOrGroupsAreLabels) {
+  for (const auto& [keyword, kind] : {std::pair{"usemtl", "materials (usemtl)"}, std::pair{"g", "groups (g)"}}) {
+    SCOPED_TRACE(keyword);
+    const std::string k = keyword;
+    io::Notes notes;
+    const Complex c = readText(io::Format::Obj,
+                               "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 2 0 0\n" + k + " wing\nf 1 2 3\n" + k +
+                                   " body part\nf 1 3 4 5\nl 1 5 2\n" + k + " wing\nf 2 5 3\n",
+                               notes);
+    EXPECT_EQ(c.labels.triangles, (std::vector<int32_t>{0, 1, 1, 0}));
+    EXPECT_EQ(c.labels.edges, (std::vector<int32_t>{1, 1}));
+    EXPECT_NE(joined(notes).find("kept the 2 " + std::string(kind) +
+                                 " of lines and faces as simplex labels, numbered in order of first use: 0 'wing', "
+                                 "1 'body part'"),
+              std::string::npos)
+        << joined(notes);
+    const Complex integers =
+        readText(io::Format::Obj, "v 0 0 0\nv 1 0 0\nv 1 1 0\n" + k + " -7\nf 1 2 3\n" + k + " 40\nl 1 2\n", notes);
+    EXPECT_EQ(integers.labels.triangles, (std::vector<int32_t>{-7}));
+    EXPECT_EQ(integers.labels.edges, (std::vector<int32_t>{40}));
+  }
 }
 
 TEST(LabelFiles, VtkCellDataLabelsRoundTrip) {
-  Complex sphere = sphereMesh(8, 10);
-  labelBySlabs(sphere, 3);
-  for (int32_t& label : sphere.labels.triangles) label = label * 1000 - 5;
-  sphere.edges = {0, 1, 2, 3};
+  Complex sphere = sphereInSlabs(8, 10, {0, 1, 2, 3});
   sphere.labels.edges = {-7, 70000};
   sphere.points = {4};
-  std::vector<uint8_t> bytes;
-  ASSERT_TRUE(io::writeMemory(io::Format::Vtk, sphere, bytes).ok());
-  io::Notes notes;
-  Complex back;
-  ASSERT_TRUE(io::readMemory(io::Format::Vtk, bytes.data(), bytes.size(), back, notes).ok());
-  ASSERT_EQ(notes.size(), 1u) << joined(notes);
-  EXPECT_EQ(notes[0], "kept the cell data array 'label' as simplex labels");
-  EXPECT_EQ(back.triangles, sphere.triangles);
-  EXPECT_EQ(back.edges, sphere.edges);
-  EXPECT_EQ(back.labels.triangles, sphere.labels.triangles);
-  EXPECT_EQ(back.labels.edges, sphere.labels.edges);
+  const ReadResult back = writeThenRead(io::Format::Vtk, sphere);
+  ASSERT_TRUE(back.status.ok()) << back.status.message;
+  ASSERT_EQ(back.notes.size(), 1u) << joined(back.notes);
+  EXPECT_EQ(back.notes[0], "kept the cell data array 'label' as simplex labels");
+  EXPECT_EQ(back.complex.triangles, sphere.triangles);
+  EXPECT_EQ(back.complex.edges, sphere.edges);
+  EXPECT_EQ(back.complex.labels.triangles, sphere.labels.triangles);
+  EXPECT_EQ(back.complex.labels.edges, sphere.labels.edges);
 }
 
 TEST(LabelFiles, FormatsWithoutLabelsRefuse) {
