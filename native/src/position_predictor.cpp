@@ -22,7 +22,7 @@ constexpr int kValenceClasses = 5;       // the last: no triangle
 constexpr int kJointValenceClasses = 3;
 constexpr int kPlaneBuckets = 6;
 constexpr int kCentroidBuckets = 10;
-constexpr int kParallelogramBuckets = CountContext::kParallelogramBuckets;  // the last: none
+constexpr int kParallelogramBuckets = PositionPredictor::kParallelogramBuckets;  // the last: none
 constexpr int kSpreadClasses = 9;
 constexpr int kAgreementClasses = 3;
 constexpr int kElongationGroups = CountContext::kElongationGroups;
@@ -304,6 +304,7 @@ void PositionPredictor::forgetAcross(uint32_t triangle, uint32_t position) {
 // The incidence lists are walked where they are: a copy of them in
 // contiguous rows, rebuilt twice per level, took more instructions and
 // memory (docs/EXPERIMENTS.md).
+template <bool kParallelograms>
 bool PositionPredictor::gather(uint32_t vertex, int level, Neighbourhood& around) {
   if (vertex >= store_.vertexCapacity() || vertex >= places_.size()) return false;
   const int axis = axis_[size_t(level)];
@@ -352,6 +353,7 @@ bool PositionPredictor::gather(uint32_t vertex, int level, Neighbourhood& around
     // The parallelogram rule: on a flat, evenly sampled surface v a c b is
     // a parallelogram, c being the far vertex of the triangle across a b;
     // listed only along the split axis, where the features look.
+    if (!kParallelograms) continue;
     uint32_t farSlot = acrossSlots[slot];
     if (farSlot == kUnknown) farSlot = searchAcross(slot, next, afterNext);
     if (farSlot != kNowhere) {
@@ -415,7 +417,7 @@ bool PositionPredictor::gatherFromProxy(uint32_t vertex, int level, Neighbourhoo
   for (int hop = 0; hop < kProxyHops && !found; ++hop) {
     proxy = proxyOf(proxy);
     if (proxy == kNoSimplex) return false;
-    found = gather(proxy, level, around);
+    found = gather<true>(proxy, level, around);
   }
   if (!found) return false;
   const int axis = axis_[size_t(level)];
@@ -437,7 +439,7 @@ bool PositionPredictor::gatherFromProxy(uint32_t vertex, int level, Neighbourhoo
 
 bool PositionPredictor::contextsOf(uint32_t vertex, int level, SingleContexts& c) {
   Neighbourhood around;
-  if (!gather(vertex, level, around) && !gatherFromProxy(vertex, level, around)) return false;
+  if (!gather<true>(vertex, level, around) && !gatherFromProxy(vertex, level, around)) return false;
   ++positionPredictions_;
   const Features f = features(around, level);
   c.mirrored = f.mirrored;
@@ -468,12 +470,10 @@ bool PositionPredictor::contextsOf(uint32_t vertex, int level, SingleContexts& c
 
 CountContext PositionPredictor::countContext(uint32_t vertex, int level) {
   Neighbourhood around;
-  if (!gather(vertex, level, around)) return {};
+  if (!gather<false>(vertex, level, around)) return {};
   ++countPredictions_;
   const Features f = features(around, level);
-  parallelogramPredictions_ += f.hasParallelogram;
   CountContext context = countContextOf(f);
-  context.parallelogram = f.parallelogram;
   context.refinement = refinementClass(around, f.mirrored, false);
   return context;
 }

@@ -30,9 +30,11 @@
 //     the triangle b a c across its far edge predict v at a + b − c (the
 //     rule single-rate coders predict with, here from the current
 //     complex); their median, and their median absolute deviation, which
-//     says how far to trust it (also for cell counts, count_coder.h); the
-//     median and its deviation rather than the mean and variance, since
-//     they hold against the parallelograms that span a crease or a fold.
+//     says how far to trust it; the median and its deviation rather than
+//     the mean and variance, since they hold against the parallelograms
+//     that span a crease or a fold. Only one-vertex splits look at them:
+//     the class of a cell's count has all the rest, as the parallelograms
+//     of a vertex that stands for several say little about the split.
 // And one more, from the order of coding: cells split level by level, so
 // the neighbours coded before the vertex at this level are known to half
 // a cell more. A neighbour in the cell's own slab along the split axis
@@ -97,6 +99,9 @@ void medianAndDeviation(double* values, uint32_t count, double& median, double& 
 
 class PositionPredictor {
  public:
+  // The parallelogram predictions' median offset in buckets, the last for
+  // none (position_predictor.cpp).
+  static constexpr int kParallelogramBuckets = 12;
   // Inputs of the one-vertex mixers: four models of the neighbourhood's
   // shape, the parallelogram odds and the refinement class's model.
   static constexpr int kSingleInputs = 6;
@@ -116,7 +121,8 @@ class PositionPredictor {
   // `level` whose vertex in the complex is `vertex`: for a plane through the
   // cell that crosses the split plane, which share of it lies on the lesser
   // side (1..5); for one that does not, how close it comes (6..9); without a
-  // plane, where the centroid lies (10..12); 0 without neighbours.
+  // plane, where the centroid lies (10..12); 0 without neighbours. No
+  // parallelogram predictions (see the top of this file).
   CountContext countContext(uint32_t vertex, int level);
 
   // Codes whether the vertex of a one-vertex cell at `level` lies in its
@@ -235,13 +241,14 @@ class PositionPredictor {
     double parallelogramOffset = 0;  // the parallelogram predictions' median offset
     double parallelogramSpread = 0;  // their squared median deviation, in squared half widths
     // The offset's bucket (position_predictor.cpp), the last for none.
-    int parallelogram = CountContext::kParallelogramBuckets - 1;
+    int parallelogram = kParallelogramBuckets - 1;
     bool hasPlane = false, hasParallelogram = false, mirrored = false;
     bool outsideUp = false;  // an oriented normal points to the upper half
   };
   Features features(const Neighbourhood& around, int level) const;
-  // Sums the neighbours of `vertex` against the split of `level`; false
-  // without any.
+  // Sums the neighbours of `vertex` against the split of `level`, with
+  // the parallelogram predictions if kParallelograms; false without any.
+  template <bool kParallelograms>
   bool gather(uint32_t vertex, int level, Neighbourhood& around);
   // The refinement class of gathered neighbours, mirrored as the features:
   // 0..CountContext::kRefinementClasses-1, or 4 times as many with
