@@ -8,11 +8,11 @@
 //   - whether the parent split sent all its vertices to one side, and
 //   - the node of the bisection tree (the decisions taken so far),
 //   - and, in a complex, a class of the cell's neighbourhood
-//     (PositionPredictor::countContext), whose models are mixed with the
-//     one above, as is a model by population group and tree node.
-//     Populations above 15 share one neighbourhood model per class and tree
-//     node: few cells are that large, and a row per bit width of the
-//     population learns more slowly,
+//     (PositionPredictor::countContext) and where the neighbours'
+//     parallelogram predictions put the cell's vertex (after a one-sided
+//     parent split), whose models are mixed with the one above. Populations above 15 share one
+//     neighbourhood model per class and tree node: few cells are that large,
+//     and a row per bit width of the population learns more slowly,
 //   - and by where the neighbours lie along the split axis, and which of
 //     them have split at this level already (PositionPredictor::
 //     refinementClass), a fourth model mixed in.
@@ -41,6 +41,10 @@ struct CountContext {
   // How the neighbours spread along the split axis (0..2), which picks the
   // mixer weights of a class.
   int elongation = 0;
+  // Where the neighbours' parallelogram predictions put the cell's vertex
+  // (PositionPredictor), kParallelogramBuckets - 1 for nowhere.
+  static constexpr int kParallelogramBuckets = 12;
+  int parallelogram = kParallelogramBuckets - 1;
   // Where the neighbours lie along the split axis, and which have split at
   // this level already (PositionPredictor::refinementClass without the far
   // halves), 0..kRefinementClasses-1.
@@ -64,8 +68,9 @@ class CountCoder {
     static_assert(size_t(kNeighbourhoodClasses) * kNeighbourhoodNodes == kFamilySize[int(ModelFamily::CellCounts)]);
     if (neighbourhoods) {
       neighbourhoodModels_.resize(kFamilySize[int(ModelFamily::CellCounts)]);
-      static_assert(size_t(kPopulationGroups) * kPopulationNodes == kFamilySize[int(ModelFamily::CellCountsByPopulation)]);
-      populationModels_.resize(kFamilySize[int(ModelFamily::CellCountsByPopulation)]);
+      static_assert(size_t(kPopulationGroups) * CountContext::kParallelogramBuckets * kParallelogramNodes ==
+                    kFamilySize[int(ModelFamily::CellCountsByParallelogram)]);
+      parallelogramModels_.resize(kFamilySize[int(ModelFamily::CellCountsByParallelogram)]);
       static_assert(size_t(CountContext::kRefinementClasses) * kRefinementNodes ==
                     kFamilySize[int(ModelFamily::CellCountsByRefinement)]);
       refinementModels_.resize(kFamilySize[int(ModelFamily::CellCountsByRefinement)]);
@@ -79,7 +84,7 @@ class CountCoder {
   void forEachFamily(Visit&& visit) {
     if (neighbourhoodModels_.empty()) return;
     visit(ModelFamily::CellCounts, neighbourhoodModels_.data());
-    visit(ModelFamily::CellCountsByPopulation, populationModels_.data());
+    visit(ModelFamily::CellCountsByParallelogram, parallelogramModels_.data());
     visit(ModelFamily::CellCountsByRefinement, refinementModels_.data());
   }
   template <class Visit>
@@ -120,11 +125,16 @@ class CountCoder {
             ? &neighbourhoodModels_[size_t(neighbourhoodClass) * kNeighbourhoodNodes +
                                     (population <= kExactPopulations ? populationOffset(population) : kSmallNodes)]
             : nullptr;
-    // And with a model by population group (2, 3, 4-7, more) and tree node
+    // And with the model of where the parallelogram predictions put the
+    // cell's vertex, by population group (2, 3, 4-7, more) and tree node
     // (from the 15th on, one model).
     const int populationGroup = population <= 2 ? 0 : population == 3 ? 1 : population <= 7 ? 2 : 3;
-    BitModel* byPopulation =
-        neighbourhoodClass > 0 ? &populationModels_[size_t(populationGroup) * kPopulationNodes] : nullptr;
+    BitModel* byParallelogram =
+        neighbourhoodClass > 0
+            ? &parallelogramModels_[size_t(populationGroup * CountContext::kParallelogramBuckets +
+                                           context.parallelogram) *
+                                    kParallelogramNodes]
+            : nullptr;
     // And with the model of where the neighbours lie along the split axis,
     // by tree node (the root, the two of the second decision, then one;
     // not by population group as well, whose priors cost more than they
@@ -140,7 +150,7 @@ class CountCoder {
       if (byNeighbourhood)
         upper = mixer_.code(coder, context.elongation * kNeighbourhoodClasses + neighbourhoodClass,
                             {&byNeighbourhood[node], &models[node],
-                             &byPopulation[std::min(node, kPopulationNodes - 1)],
+                             &byParallelogram[std::min(node, kParallelogramNodes - 1)],
                              &byRefinement[std::min(node, kRefinementNodes) - 1]},
                             upper);
       else
@@ -165,7 +175,7 @@ class CountCoder {
   static constexpr uint32_t kContextsPerLevel = kSmallNodes + 28 * kTreeNodes;
   static constexpr uint32_t kNeighbourhoodNodes = kSmallNodes + kTreeNodes;
   static constexpr int kPopulationGroups = 4;
-  static constexpr uint32_t kPopulationNodes = 16;
+  static constexpr uint32_t kParallelogramNodes = 16;
   static constexpr uint32_t kRefinementNodes = 4;
 
   static uint32_t populationOffset(uint32_t p) {
@@ -182,7 +192,7 @@ class CountCoder {
   }
 
   int levels_;
-  std::vector<BitModel> models_, neighbourhoodModels_, populationModels_, refinementModels_;
+  std::vector<BitModel> models_, neighbourhoodModels_, parallelogramModels_, refinementModels_;
   Mixer<4> mixer_;
 };
 

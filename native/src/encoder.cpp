@@ -403,7 +403,7 @@ EncodeResult encodeStream(const Complex& complex, const EncodeOptions& options, 
       }
       if (geometric)
         counts.code(coder, population, level, parentOneSided, firstHalf,
-                    connectivity ? predictor.countContext(kept, level) : CountContext{});
+                    connectivity ? predictor.countContext(kept, level, parentOneSided) : CountContext{});
       if (connectivity && added != kNoSimplex) {
         const double before = coder.cost();
         splitter.split(coder, kept, added, level, splitBalance(population, firstHalf, geometric),

@@ -33,7 +33,7 @@ namespace kdmesh {
   X(EdgeCodesByDirection, kEdgeCodeByDirectionPriors, 294)         \
   X(TriangleCodes, kTriangleCodePriors, 864)                       \
   X(OneVertexByParallelogram, kOneVertexByParallelogramPriors, 648) \
-  X(CellCountsByPopulation, kCellCountByPopulationPriors, 64)      \
+  X(CellCountsByParallelogram, kCellCountByParallelogramPriors, 768) \
   X(EdgeCodesByBalance, kEdgeCodeByBalancePriors, 2646)            \
   X(EdgeCodesByRun, kEdgeCodeByRunPriors, 1980)                    \
   X(VertexCodes, kVertexCodePriors, 36)                            \

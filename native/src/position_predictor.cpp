@@ -22,7 +22,7 @@ constexpr int kValenceClasses = 5;       // the last: no triangle
 constexpr int kJointValenceClasses = 3;
 constexpr int kPlaneBuckets = 6;
 constexpr int kCentroidBuckets = 10;
-constexpr int kParallelogramBuckets = PositionPredictor::kParallelogramBuckets;  // the last: none
+constexpr int kParallelogramBuckets = CountContext::kParallelogramBuckets;  // the last: none
 constexpr int kSpreadClasses = 9;
 constexpr int kAgreementClasses = 3;
 constexpr int kElongationGroups = CountContext::kElongationGroups;
@@ -468,12 +468,14 @@ bool PositionPredictor::contextsOf(uint32_t vertex, int level, SingleContexts& c
   return true;
 }
 
-CountContext PositionPredictor::countContext(uint32_t vertex, int level) {
+CountContext PositionPredictor::countContext(uint32_t vertex, int level, bool parentOneSided) {
   Neighbourhood around;
-  if (!gather<false>(vertex, level, around)) return {};
+  if (!(parentOneSided ? gather<true>(vertex, level, around) : gather<false>(vertex, level, around))) return {};
   ++countPredictions_;
   const Features f = features(around, level);
+  parallelogramPredictions_ += f.hasParallelogram;
   CountContext context = countContextOf(f);
+  context.parallelogram = f.parallelogram;
   context.refinement = refinementClass(around, f.mirrored, false);
   return context;
 }

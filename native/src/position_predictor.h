@@ -30,11 +30,10 @@
 //     the triangle b a c across its far edge predict v at a + b − c (the
 //     rule single-rate coders predict with, here from the current
 //     complex); their median, and their median absolute deviation, which
-//     says how far to trust it; the median and its deviation rather than
-//     the mean and variance, since they hold against the parallelograms
-//     that span a crease or a fold. Only one-vertex splits look at them:
-//     the class of a cell's count has all the rest, as the parallelograms
-//     of a vertex that stands for several say little about the split.
+//     says how far to trust it (also for the counts of cells whose parent
+//     split sent every vertex one way, count_coder.h); the median and its
+//     deviation rather than the mean and variance, since they hold against
+//     the parallelograms that span a crease or a fold.
 // And one more, from the order of coding: cells split level by level, so
 // the neighbours coded before the vertex at this level are known to half
 // a cell more. A neighbour in the cell's own slab along the split axis
@@ -99,9 +98,6 @@ void medianAndDeviation(double* values, uint32_t count, double& median, double& 
 
 class PositionPredictor {
  public:
-  // The parallelogram predictions' median offset in buckets, the last for
-  // none (position_predictor.cpp).
-  static constexpr int kParallelogramBuckets = 12;
   // Inputs of the one-vertex mixers: four models of the neighbourhood's
   // shape, the parallelogram odds and the refinement class's model.
   static constexpr int kSingleInputs = 6;
@@ -121,9 +117,13 @@ class PositionPredictor {
   // `level` whose vertex in the complex is `vertex`: for a plane through the
   // cell that crosses the split plane, which share of it lies on the lesser
   // side (1..5); for one that does not, how close it comes (6..9); without a
-  // plane, where the centroid lies (10..12); 0 without neighbours. No
-  // parallelogram predictions (see the top of this file).
-  CountContext countContext(uint32_t vertex, int level);
+  // plane, where the centroid lies (10..12); 0 without neighbours. With
+  // the parallelogram predictions only after a one-sided parent split
+  // (`parentOneSided`): the vertices of such a cell often travel together,
+  // as coincident ones do, and the parallelograms of their vertex in the
+  // complex then say where they all lie; the cells of a surface's nearby
+  // vertices, which part soon, gain little from them for the work.
+  CountContext countContext(uint32_t vertex, int level, bool parentOneSided);
 
   // Codes whether the vertex of a one-vertex cell at `level` lies in its
   // first half, and moves the vertex's cell to that half. A vertex without
@@ -241,7 +241,7 @@ class PositionPredictor {
     double parallelogramOffset = 0;  // the parallelogram predictions' median offset
     double parallelogramSpread = 0;  // their squared median deviation, in squared half widths
     // The offset's bucket (position_predictor.cpp), the last for none.
-    int parallelogram = kParallelogramBuckets - 1;
+    int parallelogram = CountContext::kParallelogramBuckets - 1;
     bool hasPlane = false, hasParallelogram = false, mirrored = false;
     bool outsideUp = false;  // an oriented normal points to the upper half
   };

@@ -307,8 +307,9 @@ struct ConnectivityStatistics {
   uint64_t edgeCodesByDirection = 0;  // edge codes conditioned on the split direction
   uint64_t countPredictions = 0;      // several-vertex cell counts with a neighbourhood class
   uint64_t positionPredictions = 0;   // one-vertex cell splits coded from the neighbours
-  // Of the one-vertex splits, those that also had the parallelogram
-  // predictions of triangles across the vertex's link.
+  // Of the two above, those that also had the parallelogram predictions of
+  // triangles across the vertex's link (cell counts: after a one-sided
+  // parent split).
   uint64_t parallelogramPredictions = 0;
   // Triangles between two edges coded 3 or 4, coded most constrained first
   // with the count of their edges' code-4 triangles (tetrahedral meshes).
