@@ -10,9 +10,10 @@
 //   - and, in a complex, a class of the cell's neighbourhood
 //     (PositionPredictor::countContext) and where the neighbours'
 //     parallelogram predictions put the cell's vertex (after a one-sided
-//     parent split), whose models are mixed with the one above. Populations above 15 share one
-//     neighbourhood model per class and tree node: few cells are that large,
-//     and a row per bit width of the population learns more slowly,
+//     parent split), whose models are mixed with the one above.
+//     Populations above 15 share one neighbourhood model per class and
+//     tree node: few cells are that large, and a row per bit width of the
+//     population learns more slowly,
 //   - and by where the neighbours lie along the split axis, and which of
 //     them have split at this level already (PositionPredictor::
 //     refinementClass), a fourth model mixed in.

@@ -224,7 +224,8 @@ struct Decoder::State {
     const bool geometric = level < schedule->levels;
     const uint32_t firstHalf =
         geometric ? counts->code(coder, population, level, cell.parentOneSided, 0,
-                                 connectivity ? predictor->countContext(cell.vertex, level, cell.parentOneSided) : CountContext{})
+                                 connectivity ? predictor->countContext(cell.vertex, level, cell.parentOneSided)
+                                              : CountContext{})
                   : population / 2;
     const bool oneSided = firstHalf == 0 || firstHalf == population;
     Cell child = cell;
