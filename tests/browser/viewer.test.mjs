@@ -59,7 +59,7 @@ async function openViewer(query, viewport = { width: 800, height: 600 }) {
 const viewerState = (page) => page.evaluate(() => ({ ...window.kdmeshViewer }));
 
 test('the dragon streams through a throttled route, refines at least 5 times and ends exact', async () => {
-  const { page, errors } = await openViewer('model=dragon.kdm&throttle=2000');
+  const { page, errors } = await openViewer('model=dragon.kdm&throttle=500');
   await page.waitForFunction(() => window.kdmeshViewer.refinements >= 2 && window.kdmeshViewer.state === 'loading', null, { timeout: 60000 });
   const early = await page.evaluate(() => window.kdmeshViewer.modelPixels());
   await page.screenshot({ path: join(screenshots, 'dragon-streaming.png') });
