@@ -137,31 +137,53 @@ constexpr uint8_t kSortEight[19][2] = {{0, 2}, {1, 3}, {4, 6}, {5, 7}, {0, 4}, {
 // Any six values in the first six places (12 comparisons, the fewest).
 constexpr uint8_t kSortSix[12][2] = {{0, 5}, {1, 3}, {2, 4}, {1, 2}, {3, 4}, {0, 3},
                                      {2, 5}, {0, 1}, {2, 3}, {4, 5}, {1, 2}, {3, 4}};
-// Eight values that fall and then rise (Batcher's bitonic merge).
-constexpr uint8_t kMergeValley[12][2] = {{0, 4}, {1, 5}, {2, 6}, {3, 7}, {0, 2}, {1, 3},
-                                         {4, 6}, {5, 7}, {0, 1}, {2, 3}, {4, 5}, {6, 7}};
+// Any four values in the first four places (5 comparisons).
+constexpr uint8_t kSortFour[5][2] = {{0, 1}, {2, 3}, {0, 2}, {1, 3}, {1, 2}};
+
+// The k-th least (from 1) of the values of two ascending runs: the least,
+// over the ways to take k values from the runs' fronts, of the greatest
+// taken. It selects one of the values, so it is exact; unrolled at compile
+// time into minima and maxima.
+template <int kRun, int kK>
+[[gnu::always_inline]] inline double kthOfTwoRuns(const double (&a)[kRun], const double (&b)[kRun]) {
+  double least = HUGE_VAL;
+  for (int fromA = std::max(0, kK - kRun); fromA <= std::min(kK, kRun); ++fromA) {
+    const double lastOfA = fromA > 0 ? a[fromA - 1] : -HUGE_VAL;
+    const double lastOfB = kK - fromA > 0 ? b[kK - fromA - 1] : -HUGE_VAL;
+    least = std::min(least, std::max(lastOfA, lastOfB));
+  }
+  return least;
+}
+
+// medianAndDeviation() of 2·kRun − 1 or 2·kRun values, sorted by `network`
+// as 2·kRun (an odd count's last one infinite, and so its deviation).
+// Sorted values fall to the median and rise after it: their deviations
+// are two ascending runs, those up to the middle read backwards and those
+// after it, whose middle values select the deviation.
+template <int kRun, size_t kComparisons>
+[[gnu::always_inline]] inline void medianAndDeviationOfFew(const double* values, uint32_t count,
+                                                           const uint8_t (&network)[kComparisons][2],
+                                                           double& median, double& deviation) {
+  double sorted[8];
+  for (uint32_t i = 0; i < 2 * kRun; ++i) sorted[i] = i < count ? values[i] : HUGE_VAL;
+  sortNetwork(sorted, network);
+  median = middleOf(sorted, count);
+  double towardsMedian[kRun], afterMedian[kRun];
+  for (int i = 0; i < kRun; ++i) {
+    towardsMedian[i] = std::fabs(sorted[kRun - 1 - i] - median);
+    afterMedian[i] = std::fabs(sorted[kRun + i] - median);
+  }
+  const double middle = kthOfTwoRuns<kRun, kRun>(towardsMedian, afterMedian);
+  deviation = count == 2 * kRun ? 0.5 * (middle + kthOfTwoRuns<kRun, kRun + 1>(towardsMedian, afterMedian)) : middle;
+}
 
 }  // namespace
 
 void medianAndDeviation(double* values, uint32_t count, double& median, double& deviation) {
-  if (count <= 8) {
-    // Most vertices of a surface have at most eight triangles: sorted as
-    // eight, the rest infinite (and so are their deviations from a finite
-    // median). Six or fewer, the commonest, need only the first six sorted.
-    double sorted[8];
-    for (uint32_t i = 0; i < 8; ++i) sorted[i] = i < count ? values[i] : HUGE_VAL;
-    if (count <= 6) {
-      sortNetwork(sorted, kSortSix);
-    } else {
-      sortNetwork(sorted, kSortEight);
-    }
-    median = middleOf(sorted, count);
-    // The deviations of sorted values fall to the median and rise after it.
-    for (double& value : sorted) value = std::fabs(value - median);
-    sortNetwork(sorted, kMergeValley);
-    deviation = middleOf(sorted, count);
-    return;
-  }
+  // Most vertices of a surface are in five to seven triangles.
+  if (count >= 5 && count <= 6) return medianAndDeviationOfFew<3>(values, count, kSortSix, median, deviation);
+  if (count >= 7 && count <= 8) return medianAndDeviationOfFew<4>(values, count, kSortEight, median, deviation);
+  if (count >= 3 && count <= 4) return medianAndDeviationOfFew<2>(values, count, kSortFour, median, deviation);
   std::sort(values, values + count);
   median = middleOf(values, count);
   for (uint32_t i = 0; i < count; ++i) values[i] = std::fabs(values[i] - median);
