@@ -11,6 +11,7 @@
 #include "count_coder.h"
 #include "kdmesh/kdmesh.h"
 #include "labels.h"
+#include "large_array.h"
 #include "position_predictor.h"
 #include "quantizer.h"
 #include "range_coder.h"
@@ -67,7 +68,7 @@ struct Decoder::State {
   // `level`, the rest one level finer. One-vertex children born during the
   // level wait in `newSingles` and are merged in at its end; keeping kd-tree
   // order lets the adaptive models follow local regularity.
-  std::vector<Cell> cells, children, singles, newSingles;
+  LargeArray<Cell> cells, children, singles, newSingles;
   size_t cursor = 0, singleCursor = 0, singleLevelEnd = 0;
   int level = 0;
   LevelCostTally levelCosts;

@@ -11,6 +11,7 @@
 #include "encoder_internal.h"
 #include "kd_order.h"
 #include "labels.h"
+#include "large_array.h"
 #include "kdmesh/kdmesh.h"
 #include "position_predictor.h"
 #include "quantizer.h"
@@ -153,8 +154,8 @@ void traverseKdTree(const std::vector<KdKey>& keys, const SplitSchedule& schedul
     bool parentOneSided;
   };
   const uint32_t n = uint32_t(keys.size());
-  std::vector<Cell> cells, children;
-  std::vector<Single> singles;
+  LargeArray<Cell> cells, children;
+  LargeArray<Single> singles;
   uint32_t nextId = 1;
   if (n == 1) {
     singles.push_back({0, 0, false});

@@ -303,15 +303,15 @@ class PositionPredictor {
   // two, so multiplying by it rounds exactly as dividing by the half width
   // would, without a division's latency.
   std::vector<double> inverseHalfWidths_;
-  std::vector<Place> places_;
-  std::vector<uint32_t> proxies_;  // per vertex in no simplex, else kNoSimplex
+  LargeArray<Place> places_;
+  LargeArray<uint32_t> proxies_;  // per vertex in no simplex, else kNoSimplex
   const SimplexStore& store_;
   // Per triangle slot (see searchAcross()), the slot of the far vertex c of the
   // triangle found across the edge opposite the slot's vertex (kNowhere: no
   // triangle; kUnknown: not searched since the triangle's star changed).
   // Searching walks a's triangles; a vertex split changes the answer only
   // for triangles of the split vertex's star (forgetAcross).
-  std::vector<uint32_t> acrossSlots_;
+  LargeArray<uint32_t> acrossSlots_;
   // The parallelogram predictions of one gather(), and their deviations.
   std::vector<double> predictions_;
   std::vector<BitModel> models_, planeModels_, centroidModels_, parallelogramModels_, refinementModels_;

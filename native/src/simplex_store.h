@@ -17,6 +17,8 @@
 #include <type_traits>
 #include <vector>
 
+#include "large_array.h"
+
 namespace kdmesh {
 
 constexpr uint32_t kNoSimplex = 0xffffffffu;
@@ -167,11 +169,11 @@ class SimplexStore {
     uint32_t hash = 0;
   };
   struct Pool {
-    std::vector<uint32_t> vertices;  // dimension + 1 per simplex
-    std::vector<uint32_t> next;      // next slot in the vertex list, per slot
-    std::vector<uint8_t> flags;
-    std::vector<uint32_t> labels;    // labelled stores only
-    std::vector<IndexSlot> table;    // open addressing
+    LargeArray<uint32_t> vertices;  // dimension + 1 per simplex
+    LargeArray<uint32_t> next;      // next slot in the vertex list, per slot
+    LargeArray<uint8_t> flags;
+    LargeArray<uint32_t> labels;    // labelled stores only
+    LargeArray<IndexSlot> table;    // open addressing
     uint32_t tableEntries = 0;       // live or not
     uint32_t capacity = 0xffffffffu;
   };
@@ -182,7 +184,7 @@ class SimplexStore {
   void rebuildIndex(int dimension);
 
   std::array<Pool, 4> pool_;                      // [0] unused
-  std::array<std::vector<uint32_t>, 4> heads_;    // [0] unused
+  std::array<LargeArray<uint32_t>, 4> heads_;    // [0] unused
   std::array<uint32_t, 4> live_{};
   bool indexed_ = true;
   bool labelled_ = false;
