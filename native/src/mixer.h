@@ -36,14 +36,18 @@ class Logistic {
 
 // The inverse of squash: for each p, the smallest d with squash(d) >= p.
 // Built by the compiler: a table made on first use cost a guard test on
-// every call.
+// every call. It covers p = 0..4096, every probability a BitModel can
+// hold in 12 bits, the ends as 1 and 4095 (certainty is not mixed), so
+// that a model's probability is stretched without a clamp.
 struct StretchTable {
-  std::array<int16_t, 4096> values{};
+  std::array<int16_t, 4097> values{};
   constexpr StretchTable() {
     int p = 0;
     for (int d = -2047; d <= 2047; ++d)
       for (const int s = Logistic::squash(d); p <= s && p < 4096; ++p) values[size_t(p)] = int16_t(d);
     for (; p < 4096; ++p) values[size_t(p)] = 2047;
+    values[0] = values[1];
+    values[4096] = values[4095];
   }
 };
 inline constexpr StretchTable kStretchTable{};
@@ -76,18 +80,15 @@ class Mixer {
 
   // The mix of `inputs` in the logistic domain, clamped to [-2047, 2047].
   int logit(int set, const std::array<BitModel*, kInputs>& inputs) {
-    for (int i = 0; i < kInputs; ++i) {
-      const int p = int(inputs[size_t(i)]->probabilityOfZero() >> 3);
-      stretched_[size_t(i)] = Logistic::stretch(p < 1 ? 1 : p > 4095 ? 4095 : p);
-    }
+    for (int i = 0; i < kInputs; ++i) stretched_[size_t(i)] = Logistic::stretch(int(inputs[size_t(i)]->probabilityOfZero() >> 3));
     return logitOfStretched(set);
   }
   // The same for inputs another mixer has stretched already.
-  int logit(int set, const std::array<int, kInputs>& stretched) {
+  int logit(int set, const std::array<int16_t, kInputs>& stretched) {
     stretched_ = stretched;
     return logitOfStretched(set);
   }
-  const std::array<int, kInputs>& stretched() const { return stretched_; }
+  const std::array<int16_t, kInputs>& stretched() const { return stretched_; }
 
   // P(bit == 0) in units of 2^-15 for the coder.
   uint32_t mix(int set, const std::array<BitModel*, kInputs>& inputs) {
@@ -112,9 +113,9 @@ class Mixer {
   void update(bool bit) {
     // A small rate: the inputs are adaptive models already, the weights
     // only settle how far to trust each.
-    const int error = (bit ? 0 : 4095) - mixed_;
+    const int16_t error = int16_t((bit ? 0 : 4095) - mixed_);
     for (int i = 0; i < kInputs; ++i)
-      weights_[size_t(set_)][size_t(i)] += (stretched_[size_t(i)] * error) >> 10;
+      weights_[size_t(set_)][size_t(i)] += (int32_t(stretched_[size_t(i)]) * error) >> 10;
   }
 
  private:
@@ -131,7 +132,7 @@ class Mixer {
 
   std::vector<std::array<int32_t, kInputs>> weights_;
   std::vector<uint32_t> uses_;
-  std::array<int, kInputs> stretched_{};
+  std::array<int16_t, kInputs> stretched_{};
   int mixed_ = 2048, set_ = 0;
 };
 

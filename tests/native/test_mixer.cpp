@@ -26,6 +26,15 @@ TEST(Logistic, SquashIsMonotoneAndStretchInvertsIt) {
     EXPECT_GE(Logistic::squash(d), p) << p;
     EXPECT_LT(Logistic::squash(d - 1), p) << p;
   }
+  // A model's 12-bit probability runs from 0 to 4096: certainty stretches
+  // as the nearest probabilities that are not.
+  EXPECT_EQ(Logistic::stretch(0), Logistic::stretch(1));
+  EXPECT_EQ(Logistic::stretch(4096), Logistic::stretch(4095));
+  EXPECT_LT(Logistic::stretch(1), Logistic::stretch(2048));
+  EXPECT_GT(Logistic::stretch(4095), Logistic::stretch(2048));
+  BitModel certain;
+  certain.fast = certain.slow = uint16_t(kProbabilityOne);
+  EXPECT_EQ(certain.probabilityOfZero() >> 3, 4096u);
 }
 
 // Bits that are 0 nine times in ten: an input model that knows it and one
