@@ -1,9 +1,8 @@
 // Arrays that grow with the model (simplex pools, per-vertex state): on
 // Linux, allocations of several megabytes ask for transparent huge pages.
 //
-// A model of a million triangles touches a few hundred megabytes while it is
-// coded, and every fresh 4 KiB page costs a page fault (in a virtual machine
-// about 10 µs): the dragon's decode took 42,000 of them. Advised with
+// A model of a million triangles touches a hundred megabytes or more while
+// it is coded, and every fresh 4 KiB page costs a page fault. Advised with
 // MADV_HUGEPAGE before it is first touched, an allocation faults in 2 MiB at
 // a time, and its accesses miss the TLB less. The advice is only advice:
 // where the kernel has huge pages off (or on other systems, and in

@@ -80,7 +80,8 @@ class Mixer {
 
   // The mix of `inputs` in the logistic domain, clamped to [-2047, 2047].
   int logit(int set, const std::array<BitModel*, kInputs>& inputs) {
-    for (int i = 0; i < kInputs; ++i) stretched_[size_t(i)] = Logistic::stretch(int(inputs[size_t(i)]->probabilityOfZero() >> 3));
+    for (int i = 0; i < kInputs; ++i)
+      stretched_[size_t(i)] = Logistic::stretch(int(inputs[size_t(i)]->probabilityOfZero() >> 3));
     return logitOfStretched(set);
   }
   // The same for inputs another mixer has stretched already.

@@ -46,7 +46,8 @@ TEST(MedianAndDeviation, SmallCases) {
   EXPECT_EQ(deviation, 0.25);
 }
 
-// Both paths (sorting networks up to eight values, a sort beyond) against
+// Every path (sorting networks for three to eight values, a sort otherwise)
+// against
 // the definition, with ties, signed zeros and halves as the decoder's
 // offsets have them.
 TEST(MedianAndDeviation, MatchesTheDefinitionForEveryCount) {
