@@ -14,9 +14,12 @@ namespace {
 
 TEST(Logistic, SquashIsMonotoneAndStretchInvertsIt) {
   EXPECT_EQ(Logistic::squash(0), 2048);
+  EXPECT_EQ(Logistic::squash(-5000), Logistic::squash(-2047));
+  EXPECT_EQ(Logistic::squash(5000), Logistic::squash(2047));
   int previous = 0;
   for (int d = -2047; d <= 2047; ++d) {
     const int p = Logistic::squash(d);
+    ASSERT_EQ(p, Logistic::interpolatedSquash(d)) << d;
     ASSERT_GE(p, previous) << d;
     previous = p;
   }
