@@ -233,7 +233,7 @@ void exportModels(PositionPredictor& predictor, CountCoder& counts, VertexSplitt
   auto keepMixer = [&out](MixerFamily family, const auto& mixer) {
     std::vector<int32_t>& weights = out.mixerWeights[size_t(family)];
     weights.clear();
-    for (const auto& set : mixer.weights()) weights.insert(weights.end(), set.begin(), set.end());
+    mixer.appendWeights(weights);
     out.mixerUses[size_t(family)] = mixer.uses();
   };
   predictor.forEachFamily(keep);
