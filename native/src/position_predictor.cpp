@@ -90,16 +90,26 @@ int spreadClass(double spread) {
 // slabs −1, 0 and 1 (the cell's own and the two beside it) and the sides
 // −1 (lower half), 0 (not split yet) and 1; bin 9 for slabs farther off.
 // Offsets are exact (multiples of 1/4 grid steps) and twice one is an
-// integer of magnitude below 2^33, so integers place it: the quarter
-// 4 · slab + side. Biased to be positive, its shift and mask are a floor
-// and a modulo.
+// integer q = 4 · slab + side of magnitude below 2^33; the three slabs
+// are q = −5..6 (q = 4 · slab + 2 does not arise; it counts as side 0),
+// looked up in a table.
+namespace {
+struct AlongBins {
+  int8_t bins[12] = {};
+  constexpr AlongBins() {
+    constexpr int kSide[4] = {0, 1, 0, -1};  // by q mod 4
+    for (int q = -5; q <= 6; ++q) {
+      const int slab = (q + 1 + 8) / 4 - 2;  // floor((q + 1) / 4)
+      bins[q + 5] = int8_t(3 * (slab + 1) + kSide[(q + 8) % 4] + 1);
+    }
+  }
+};
+constexpr AlongBins kAlongBins{};
+}  // namespace
+
 int alongBin(double offset) {
-  constexpr int64_t kBias = int64_t(1) << 36;
-  const uint64_t quarters = uint64_t(int64_t(offset * 2) + kBias);
-  static constexpr int kSide[4] = {0, 1, 0, -1};
-  const int64_t slab = int64_t((quarters + 1) >> 2) - kBias / 4;
-  const int64_t bin = 3 * (slab + 1) + kSide[quarters & 3] + 1;
-  return uint64_t(slab + 1) <= 2 ? int(bin) : 9;
+  const uint64_t index = uint64_t(int64_t(offset * 2) + 5);
+  return index < 12 ? kAlongBins.bins[index] : 9;
 }
 
 namespace {

@@ -88,6 +88,12 @@ TEST(AlongBin, PlacesNeighboursBySlabAndSide) {
       }
     }
   }
+  // Half a width off the grid (not a place the decoder gives a cell):
+  // the slab below, not split.
+  EXPECT_EQ(alongBin(1.0), 4);
+  EXPECT_EQ(alongBin(-1.0), 1);
+  EXPECT_EQ(alongBin(3.0), 7);
+  EXPECT_EQ(alongBin(-3.0), 9);
   // Far off on a 30-bit grid, with no overflow.
   EXPECT_EQ(alongBin(std::ldexp(1.0, 31) + 0.5), 9);
   EXPECT_EQ(alongBin(-std::ldexp(1.0, 31) - 0.5), 9);
