@@ -91,8 +91,8 @@ int spreadClass(double spread) {
 // −1 (lower half), 0 (not split yet) and 1; bin 9 for slabs farther off.
 // Offsets are exact (multiples of 1/4 grid steps) and twice one is an
 // integer q = 4 · slab + side of magnitude below 2^33; the three slabs
-// are q = −5..6 (q = 4 · slab + 2 does not arise; it counts as side 0),
-// looked up in a table.
+// are q = −5..6 (q = 4 · slab + 2, half a width off the grid, does not
+// arise; it counts in the lower slab, not split), looked up in a table.
 namespace {
 struct AlongBins {
   int8_t bins[12] = {};

@@ -46,10 +46,9 @@ TEST(MedianAndDeviation, SmallCases) {
   EXPECT_EQ(deviation, 0.25);
 }
 
-// Every path (sorting networks for three to eight values, a sort otherwise)
-// against
-// the definition, with ties, signed zeros and halves as the decoder's
-// offsets have them.
+// Every path (sorting networks for three to eight values, a sort
+// otherwise) against the definition, with ties, signed zeros and halves as
+// the decoder's offsets have them.
 TEST(MedianAndDeviation, MatchesTheDefinitionForEveryCount) {
   uint32_t state = 2024;
   auto next = [&] {
@@ -89,7 +88,7 @@ TEST(AlongBin, PlacesNeighboursBySlabAndSide) {
     }
   }
   // Half a width off the grid (not a place the decoder gives a cell):
-  // the slab below, not split.
+  // the lower of the two slabs it lies between, not split.
   EXPECT_EQ(alongBin(1.0), 4);
   EXPECT_EQ(alongBin(-1.0), 1);
   EXPECT_EQ(alongBin(3.0), 7);
