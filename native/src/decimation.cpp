@@ -150,9 +150,27 @@ void decimate(SimplexStore& store, const std::vector<VertexSplitIds>& splits,
     uint32_t& mine = store.label(d, simplex);
     if (mine == kNoLabel) mine = label;
   };
+  // Every simplex a merge looks up holds v1 and was in v1's star before
+  // the merge (see below): looked up there by binary search, not in the
+  // store's hash index, whose probes missed the cache on large inputs.
+  store.dropIndex();
   std::vector<uint32_t> star2;
-  std::vector<StarEntry> star;
-  std::array<size_t, 5> begin{};
+  std::vector<StarEntry> star, starOfKept;
+  std::array<size_t, 5> begin{}, beginOfKept{};
+  // The simplex of v1's star before the merge with these other vertices
+  // (ascending, `dimension` of them), or kNoSimplex.
+  auto findAroundKept = [&](int dimension, const uint32_t* others) {
+    const StarEntry* entry = findInStar(starOfKept, beginOfKept, dimension, others);
+    return entry ? entry->simplex : kNoSimplex;
+  };
+  // The vertices of a simplex but `skip` and `skipToo`, ascending.
+  auto othersBut = [&store](int d, uint32_t simplex, uint32_t skip, uint32_t skipToo, uint32_t (&out)[3]) {
+    const uint32_t* v = store.vertices(d, simplex);
+    int n = 0;
+    for (int i = 0; i <= d; ++i)
+      if (v[i] != skip && v[i] != skipToo) out[n++] = v[i];
+    std::sort(out, out + n);
+  };
   records.bytes.clear();
   // Merges are recorded last split first, into `reversed`; each split's
   // length turns into its forward `begin` at the end.
@@ -163,8 +181,12 @@ void decimate(SimplexStore& store, const std::vector<VertexSplitIds>& splits,
   for (size_t k = splits.size(); k-- > 0;) {
     if (progress && (k & 0xffff) == 0) progress(1.0 - double(k) / double(splits.size()));
     const uint32_t v1 = splits[k].kept, v2 = splits[k].added;
-    const uint32_t edge[2] = {v1, v2};
-    const bool joined = store.find(1, edge) != kNoSimplex;
+    // A simplex of v2 with v1 loses v2 and its face without v2 holds v1;
+    // one without v1 takes v1 for v2 and its twin, if any, holds v1. Both
+    // lookups find simplices that hold v1 but not v2, and none of the merge's
+    // changes makes or kills one: v1's star before the merge answers them.
+    gatherStar(store, v1, starOfKept, beginOfKept);
+    const bool joined = findAroundKept(1, &v2) != kNoSimplex;
     uint32_t joiningLabel = kNoLabel;  // of the edge v1 v2
 
     for (int d = 1; d <= 3; ++d) {
@@ -178,11 +200,9 @@ void decimate(SimplexStore& store, const std::vector<VertexSplitIds>& splits,
         if (std::find(sv, sv + d + 1, v1) != sv + d + 1) {
           // S = S' ∪ {v1, v2}: the decoder makes it by coding S' as 4.
           if (d >= 2) {
-            uint32_t face[3];
-            int n = 0;
-            for (int i = 0; i <= d; ++i)
-              if (sv[i] != v2) face[n++] = sv[i];
-            const uint32_t parent = store.find(d - 1, face);
+            uint32_t faceOthers[3];
+            othersBut(d, s, v1, v2, faceOthers);
+            const uint32_t parent = findAroundKept(d - 1, faceOthers);
             scratch[size_t(d - 1)][parent] |=
                 uint8_t(kHasAdded | (target << split_record::kNewTargetShift));
             if (labelled) {
@@ -195,10 +215,9 @@ void decimate(SimplexStore& store, const std::vector<VertexSplitIds>& splits,
           store.kill(d, s);
           continue;
         }
-        uint32_t merged[4];
-        std::copy(sv, sv + d + 1, merged);
-        *std::find(merged, merged + d + 1, v2) = v1;
-        const uint32_t twin = store.find(d, merged);
+        uint32_t twinOthers[3];
+        othersBut(d, s, v2, v2, twinOthers);
+        const uint32_t twin = findAroundKept(d, twinOthers);
         if (twin == kNoSimplex) {
           // Only v2 has it: code 2.
           const uint32_t position = uint32_t(std::find(sv, sv + d + 1, v2) - sv);
@@ -216,6 +235,9 @@ void decimate(SimplexStore& store, const std::vector<VertexSplitIds>& splits,
         uint8_t& twinFlags = store.flags(d, twin);
         if (d >= 2 && meaningful && !(twinFlags & SimplexStore::kMeaningful)) {
           // The coarse simplex takes the orientation of the one that matters.
+          uint32_t merged[4];
+          std::copy(sv, sv + d + 1, merged);
+          *std::find(merged, merged + d + 1, v2) = v1;
           const int wanted = tupleParity(merged, d + 1) ^ ((store.flags(d, s) & SimplexStore::kFlipped) ? 1 : 0);
           if (store.parity(d, twin) != wanted) twinFlags ^= SimplexStore::kFlipped;
           twinFlags |= SimplexStore::kMeaningful;

@@ -5,7 +5,7 @@
 namespace kdmesh {
 
 void SimplexStore::reset(uint32_t vertexCapacity, bool indexed) {
-  indexed_ = indexed;
+  indexed_ = hashed_ = indexed;
   labelled_ = false;
   for (int d = 1; d <= kMaxDimension; ++d) {
     pool_[d] = Pool{};
@@ -85,7 +85,7 @@ uint32_t SimplexStore::add(int dimension, const uint32_t* vertices, uint8_t flag
   pool.flags.push_back(uint8_t(flags | kAlive));
   if (labelled_) pool.labels.push_back(label);
   ++live_[dimension];
-  if (indexed_) insertIndex(dimension, simplex);
+  if (hashed_) insertIndex(dimension, simplex);
   // Slots pushed one by one: resize() was an out-of-line call in the
   // decoder's third most frequent function.
   for (uint32_t i = 0; i < arity; ++i) {
@@ -97,6 +97,7 @@ uint32_t SimplexStore::add(int dimension, const uint32_t* vertices, uint8_t flag
 
 uint32_t SimplexStore::find(int dimension, const uint32_t* vertices) const {
   const Pool& pool = pool_[dimension];
+  if (pool.table.empty()) return kNoSimplex;
   const size_t mask = pool.table.size() - 1;
   const uint32_t hash = hashOf(dimension, vertices);
   for (size_t at = hash & mask;; at = (at + 1) & mask) {
@@ -104,6 +105,14 @@ uint32_t SimplexStore::find(int dimension, const uint32_t* vertices) const {
     if (entry.simplex == kNoSimplex) return kNoSimplex;
     if (entry.hash == hash && (pool.flags[entry.simplex] & kAlive) && sameSet(dimension, entry.simplex, vertices))
       return entry.simplex;
+  }
+}
+
+void SimplexStore::dropIndex() {
+  hashed_ = false;
+  for (int d = 1; d <= kMaxDimension; ++d) {
+    pool_[d].table = LargeArray<IndexSlot>();
+    pool_[d].tableEntries = 0;
   }
 }
 
@@ -115,7 +124,7 @@ void SimplexStore::kill(int dimension, uint32_t simplex) {
 void SimplexStore::replaceVertex(int dimension, uint32_t simplex, uint32_t from, uint32_t to) {
   uint32_t* v = &pool_[dimension].vertices[size_t(simplex) * size_t(dimension + 1)];
   for (int i = 0; i <= dimension; ++i) v[i] = v[i] == from ? to : v[i];  // no branch to mispredict
-  if (indexed_) insertIndex(dimension, simplex);
+  if (hashed_) insertIndex(dimension, simplex);
 }
 
 bool SimplexStore::hasIncident(int dimension, uint32_t vertex) const {

@@ -68,8 +68,12 @@ class SimplexStore {
   // stores only.
   uint32_t add(int dimension, const uint32_t* vertices, uint8_t flags, uint32_t label = kNoLabel);
   // Index of the live simplex with this vertex set, or kNoSimplex (indexed
-  // stores only).
+  // stores only, before dropIndex()).
   uint32_t find(int dimension, const uint32_t* vertices) const;
+  // Frees the hash index and stops keeping it, for an indexed store that
+  // needs no more find(): killed simplices stay killed and walks still
+  // skip them.
+  void dropIndex();
   // Indexed stores only: the walks of an unindexed store (the decoder's)
   // do not look at the flags, since nothing is killed there.
   void kill(int dimension, uint32_t simplex);
@@ -186,7 +190,8 @@ class SimplexStore {
   std::array<Pool, 4> pool_;                      // [0] unused
   std::array<LargeArray<uint32_t>, 4> heads_;    // [0] unused
   std::array<uint32_t, 4> live_{};
-  bool indexed_ = true;
+  bool indexed_ = true;  // simplices may be killed
+  bool hashed_ = true;   // the hash index is kept
   bool labelled_ = false;
 };
 

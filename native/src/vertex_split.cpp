@@ -1,5 +1,6 @@
 #include "vertex_split.h"
 
+#include <algorithm>
 #include <cmath>
 #include <utility>
 
@@ -106,19 +107,32 @@ void gatherStar(SimplexStore& store, uint32_t v, std::vector<StarEntry>& star,
 }
 
 // A binary search whose steps are conditional moves, not branches: which
-// half holds the face is a coin toss for the branch predictor.
-const VertexSplitter::Entry* VertexSplitter::findFace(int dimension, const uint32_t* others) const {
-  if (dimension == 0) return &star_[0];
-  const Entry* base = star_.data() + begin_[size_t(dimension)];
-  size_t count = begin_[size_t(dimension) + 1] - begin_[size_t(dimension)];
+// half holds the entry is a coin toss for the branch predictor.
+const StarEntry* findInStar(const std::vector<StarEntry>& star, const std::array<size_t, 5>& begin, int dimension,
+                            const uint32_t* others) {
+  if (dimension == 0) return &star[0];
+  const StarEntry* base = star.data() + begin[size_t(dimension)];
+  size_t count = begin[size_t(dimension) + 1] - begin[size_t(dimension)];
   if (count == 0) return nullptr;
+  if (dimension == 3) {  // three other vertices: no 64-bit key
+    while (count > 1) {
+      const size_t half = count / 2;
+      base = lessOthers(others, base[half].others, 3) ? base : base + half;
+      count -= half;
+    }
+    return std::equal(others, others + 3, base->others) ? base : nullptr;
+  }
   const uint64_t key = othersKey(others, dimension);
-  while (count > 1) {  // the face, if present, is in base[0..count)
+  while (count > 1) {  // the entry, if present, is in base[0..count)
     const size_t half = count / 2;
     base = othersKey(base[half].others, dimension) <= key ? base + half : base;
     count -= half;
   }
   return othersKey(base->others, dimension) == key ? base : nullptr;
+}
+
+const VertexSplitter::Entry* VertexSplitter::findFace(int dimension, const uint32_t* others) const {
+  return findInStar(star_, begin_, dimension, others);
 }
 
 uint8_t VertexSplitter::possibleCodes(const Entry& entry) const {

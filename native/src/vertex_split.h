@@ -97,6 +97,10 @@ struct StarEntry {
 // dimension d, begin[4] the end.
 void gatherStar(SimplexStore& store, uint32_t v, std::vector<StarEntry>& star,
                 std::array<size_t, 5>& begin);
+// The entry of dimension d of such a star whose other vertices are
+// `others` (d of them, ascending), or nullptr; d = 0 gives the vertex.
+const StarEntry* findInStar(const std::vector<StarEntry>& star, const std::array<size_t, 5>& begin, int dimension,
+                            const uint32_t* others);
 
 class VertexSplitter {
  public:

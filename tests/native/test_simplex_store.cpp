@@ -89,5 +89,26 @@ TEST(SimplexStore, FindAgreesWithASetModelThroughKillsAndReplacements) {
   }
 }
 
+// After dropIndex() a store keeps its kills (walks skip killed simplices)
+// and takes adds and vertex replacements without an index.
+TEST(SimplexStore, DroppedIndexKeepsKillsAndWalks) {
+  SimplexStore store;
+  store.reset(8, true);
+  const uint32_t a[3] = {0, 1, 2}, b[3] = {0, 2, 3}, c[3] = {0, 3, 4};
+  const uint32_t first = store.add(2, a, 0);
+  const uint32_t second = store.add(2, b, 0);
+  store.dropIndex();
+  EXPECT_EQ(store.find(2, a), kNoSimplex);  // no index to ask
+  store.kill(2, first);
+  const uint32_t third = store.add(2, c, 0);
+  store.replaceVertex(2, second, 3, 5);
+  std::vector<uint32_t> around;
+  store.forEachIncident(2, 0, [&](uint32_t simplex, uint32_t) { around.push_back(simplex); });
+  std::sort(around.begin(), around.end());
+  EXPECT_EQ(around, (std::vector<uint32_t>{second, third}));
+  EXPECT_EQ(sortedVertices(store, 2, second), (VertexSet{0, 2, 5}));
+  EXPECT_EQ(store.liveCount(2), 2u);
+}
+
 }  // namespace
 }  // namespace kdmesh
