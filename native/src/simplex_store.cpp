@@ -5,7 +5,7 @@
 namespace kdmesh {
 
 void SimplexStore::reset(uint32_t vertexCapacity, bool indexed) {
-  indexed_ = hashed_ = indexed;
+  indexed_ = indexed;
   labelled_ = false;
   for (int d = 1; d <= kMaxDimension; ++d) {
     pool_[d] = Pool{};
@@ -85,7 +85,7 @@ uint32_t SimplexStore::add(int dimension, const uint32_t* vertices, uint8_t flag
   pool.flags.push_back(uint8_t(flags | kAlive));
   if (labelled_) pool.labels.push_back(label);
   ++live_[dimension];
-  if (hashed_) insertIndex(dimension, simplex);
+  if (!pool.table.empty()) insertIndex(dimension, simplex);
   // Slots pushed one by one: resize() was an out-of-line call in the
   // decoder's third most frequent function.
   for (uint32_t i = 0; i < arity; ++i) {
@@ -109,7 +109,6 @@ uint32_t SimplexStore::find(int dimension, const uint32_t* vertices) const {
 }
 
 void SimplexStore::dropIndex() {
-  hashed_ = false;
   for (int d = 1; d <= kMaxDimension; ++d) {
     pool_[d].table = LargeArray<IndexSlot>();
     pool_[d].tableEntries = 0;
@@ -124,7 +123,7 @@ void SimplexStore::kill(int dimension, uint32_t simplex) {
 void SimplexStore::replaceVertex(int dimension, uint32_t simplex, uint32_t from, uint32_t to) {
   uint32_t* v = &pool_[dimension].vertices[size_t(simplex) * size_t(dimension + 1)];
   for (int i = 0; i <= dimension; ++i) v[i] = v[i] == from ? to : v[i];  // no branch to mispredict
-  if (hashed_) insertIndex(dimension, simplex);
+  if (!pool_[dimension].table.empty()) insertIndex(dimension, simplex);
 }
 
 bool SimplexStore::hasIncident(int dimension, uint32_t vertex) const {

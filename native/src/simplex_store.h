@@ -177,7 +177,7 @@ class SimplexStore {
     LargeArray<uint32_t> next;      // next slot in the vertex list, per slot
     LargeArray<uint8_t> flags;
     LargeArray<uint32_t> labels;    // labelled stores only
-    LargeArray<IndexSlot> table;    // open addressing
+    LargeArray<IndexSlot> table;    // open addressing; empty: no index kept
     uint32_t tableEntries = 0;       // live or not
     uint32_t capacity = 0xffffffffu;
   };
@@ -191,7 +191,6 @@ class SimplexStore {
   std::array<LargeArray<uint32_t>, 4> heads_;    // [0] unused
   std::array<uint32_t, 4> live_{};
   bool indexed_ = true;  // simplices may be killed
-  bool hashed_ = true;   // the hash index is kept
   bool labelled_ = false;
 };
 
