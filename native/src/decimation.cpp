@@ -18,18 +18,14 @@ bool hasRepeatedVertex(const uint32_t* v, int arity) {
   return false;
 }
 
-// Adds the faces of a simplex of dimension d >= 2 that are missing.
-void addMissingFaces(SimplexStore& store, int d, const uint32_t* v) {
-  for (int skip = 0; skip <= d; ++skip) {
-    uint32_t face[3];
-    int n = 0;
-    for (int i = 0; i <= d; ++i)
-      if (i != skip) face[n++] = v[i];
-    if (store.find(d - 1, face) != kNoSimplex) continue;
-    store.add(d - 1, face, 0);
-    if (d - 1 >= 2) addMissingFaces(store, d - 1, face);
-  }
-}
+// The closure's simplices of one dimension in the order the build meets
+// them: each as its tuple (in the listed or face order of its vertices) and
+// the listed simplex it is (its index in the complex's list), or kNoSimplex
+// for a face of a higher simplex.
+struct Candidates {
+  LargeArray<uint32_t> tuples;
+  LargeArray<uint32_t> listed;
+};
 
 // Scratch bits of a record byte under construction; the final byte holds
 // only code and targets.
@@ -58,6 +54,80 @@ void layOutInSplitOrder(const std::vector<T>& reversed, const std::vector<uint64
 
 }  // namespace
 
+namespace {
+
+// firstWithSameVertices() for tuples of kArity vertices. Each tuple becomes
+// a record of its vertices but the least, ascending, and its index; the
+// records are placed by least vertex (a counting sort, which keeps their
+// order), and each vertex's records are sorted by the rest, equal sets by
+// index, so that a run of one vertex set starts with its first tuple. The
+// records, not indices into the tuples, are what moves: sorting indices
+// read the tuples at random, a cache miss per comparison on large inputs.
+template <size_t kArity>
+LargeArray<uint32_t> firstWithSameVerticesOf(const LargeArray<uint32_t>& tuples, uint32_t vertexCount) {
+  using Record = std::array<uint32_t, kArity>;  // [kArity - 1]: the tuple's index
+  const size_t count = tuples.size() / kArity;
+  if (count == 0) return {};
+  // The vertices ascending, by a network of minima and maxima.
+  auto sorted = [&tuples](size_t i) {
+    std::array<uint32_t, kArity> v;
+    std::copy_n(tuples.begin() + std::ptrdiff_t(i * kArity), kArity, v.begin());
+    auto order = [&v](size_t a, size_t b) {
+      const uint32_t low = std::min(v[a], v[b]);
+      v[b] = std::max(v[a], v[b]);
+      v[a] = low;
+    };
+    if constexpr (kArity == 2) {
+      order(0, 1);
+    } else if constexpr (kArity == 3) {
+      order(0, 1), order(1, 2), order(0, 1);
+    } else {
+      order(0, 1), order(2, 3), order(0, 2), order(1, 3), order(1, 2);
+    }
+    return v;
+  };
+  std::vector<uint32_t> start(size_t(vertexCount) + 1, 0);
+  for (size_t i = 0; i < count; ++i) ++start[size_t(*std::min_element(&tuples[i * kArity], &tuples[i * kArity] + kArity)) + 1];
+  for (size_t v = 0; v < vertexCount; ++v) start[v + 1] += start[v];
+  LargeArray<Record> records(count);
+  {
+    std::vector<uint32_t> next(start.begin(), start.end() - 1);  // where each vertex's next record goes
+    for (size_t i = 0; i < count; ++i) {
+      const std::array<uint32_t, kArity> v = sorted(i);
+      Record& record = records[next[v[0]]++];
+      std::copy_n(v.begin() + 1, kArity - 1, record.begin());
+      record[kArity - 1] = uint32_t(i);
+    }
+  }
+  LargeArray<uint32_t> first(count);
+  auto sameSet = [](const Record& a, const Record& b) { return std::equal(a.begin(), a.end() - 1, b.begin()); };
+  for (size_t v = 0; v < vertexCount; ++v) {
+    const auto begin = records.begin() + std::ptrdiff_t(start[v]);
+    const auto end = records.begin() + std::ptrdiff_t(start[v + 1]);
+    if (end - begin > 1) std::sort(begin, end);
+    for (auto run = begin; run != end;) {
+      auto past = run + 1;
+      while (past != end && sameSet(*run, *past)) ++past;
+      for (auto it = run; it != past; ++it) first[(*it)[kArity - 1]] = (*run)[kArity - 1];
+      run = past;
+    }
+  }
+  return first;
+}
+
+}  // namespace
+
+LargeArray<uint32_t> firstWithSameVertices(const LargeArray<uint32_t>& tuples, int arity, uint32_t vertexCount) {
+  switch (arity) {
+    case 2:
+      return firstWithSameVerticesOf<2>(tuples, vertexCount);
+    case 3:
+      return firstWithSameVerticesOf<3>(tuples, vertexCount);
+    default:
+      return firstWithSameVerticesOf<4>(tuples, vertexCount);
+  }
+}
+
 Status buildInputComplex(const Complex& complex, const std::vector<uint32_t>& ids,
                          SimplexStore& store, InputSummary& summary) {
   const size_t n = complex.vertexCount();
@@ -80,11 +150,29 @@ Status buildInputComplex(const Complex& complex, const std::vector<uint32_t>& id
                                  " refers to vertex " + std::to_string(list[i]) + ", but there are " +
                                  std::to_string(n) + " vertices");
   }
-  // Highest dimension first, so that a listed face of a listed simplex is
-  // recognised whatever the order of the lists.
+  // Per dimension, the listed simplices after the faces of the dimension
+  // above, each face after the simplex it bounds and in the order of the
+  // vertex left out: the first simplex of each vertex set is kept. So a
+  // listed face of a listed simplex is recognised (and counted redundant)
+  // whatever the order of the lists, and faces appear in the order a walk
+  // of the lists that added each missing face at once would add them.
+  std::array<Candidates, 4> candidates;
   for (int d = 3; d >= 1; --d) {
-    const std::vector<uint32_t>& list = *lists[d];
     const size_t arity = size_t(d + 1);
+    Candidates& mine = candidates[size_t(d)];
+    const size_t faces = d < 3 ? candidates[size_t(d) + 1].listed.size() * (arity + 1) : 0;
+    mine.tuples.reserve((faces + lists[d]->size() / arity) * arity);
+    mine.listed.reserve(faces + lists[d]->size() / arity);
+    if (d < 3) {
+      const Candidates& above = candidates[size_t(d) + 1];
+      for (size_t at = 0; at < above.tuples.size(); at += arity + 1)
+        for (size_t skip = 0; skip <= arity; ++skip) {
+          for (size_t i = 0; i <= arity; ++i)
+            if (i != skip) mine.tuples.push_back(above.tuples[at + i]);
+          mine.listed.push_back(kNoSimplex);
+        }
+    }
+    const std::vector<uint32_t>& list = *lists[d];
     for (size_t i = 0; i < list.size(); i += arity) {
       uint32_t v[4];
       for (size_t j = 0; j < arity; ++j) v[j] = ids[list[i + j]];
@@ -92,21 +180,38 @@ Status buildInputComplex(const Complex& complex, const std::vector<uint32_t>& id
         ++summary.repairs.degenerate[size_t(d)];
         continue;
       }
-      const uint32_t existing = store.find(d, v);
-      if (existing != kNoSimplex) {
-        const bool listed = store.flags(d, existing) & SimplexStore::kMeaningful;
-        ++(listed ? summary.repairs.duplicate : summary.repairs.redundant)[size_t(d)];
+      mine.tuples.insert(mine.tuples.end(), v, v + arity);
+      mine.listed.push_back(uint32_t(i / arity));
+    }
+  }
+  for (int d = 3; d >= 1; --d) {
+    Candidates& mine = candidates[size_t(d)];
+    const LargeArray<uint32_t> first = firstWithSameVertices(mine.tuples, d + 1, uint32_t(n));
+    // The pool at its final size at once, not grown by doubling.
+    uint32_t kept = 0;
+    for (size_t c = 0; c < first.size(); ++c) kept += first[c] == c;
+    store.setCapacity(d, kNoSimplex, kept);
+    for (size_t c = 0; c < first.size(); ++c) {
+      const uint32_t listed = mine.listed[c];
+      if (first[c] != c) {
+        if (listed != kNoSimplex)
+          ++(mine.listed[first[c]] != kNoSimplex ? summary.repairs.duplicate : summary.repairs.redundant)[size_t(d)];
+        continue;
+      }
+      const uint32_t* tuple = &mine.tuples[c * size_t(d + 1)];
+      if (listed == kNoSimplex) {
+        store.add(d, tuple, 0);
         continue;
       }
       const uint32_t label =
-          table.empty() ? kNoLabel
-                        : uint32_t(std::lower_bound(table.begin(), table.end(), labelOf(complex, d, i / arity)) -
-                                   table.begin());
-      store.add(d, v, SimplexStore::kMeaningful, label);
+          table.empty()
+              ? kNoLabel
+              : uint32_t(std::lower_bound(table.begin(), table.end(), labelOf(complex, d, listed)) - table.begin());
+      store.add(d, tuple, SimplexStore::kMeaningful, label);
       ++summary.maximal[size_t(d)];
       summary.maxDimension = std::max(summary.maxDimension, d);
-      if (d >= 2) addMissingFaces(store, d, v);
     }
+    mine = Candidates{};  // the faces below were listed already
   }
   for (uint32_t point : complex.points)
     if (store.hasIncident(1, ids[point])) ++summary.repairs.redundant[0];
@@ -151,9 +256,7 @@ void decimate(SimplexStore& store, const std::vector<VertexSplitIds>& splits,
     if (mine == kNoLabel) mine = label;
   };
   // Every simplex a merge looks up holds v1 and was in v1's star before
-  // the merge (see below): looked up there by binary search, not in the
-  // store's hash index, whose probes missed the cache on large inputs.
-  store.dropIndex();
+  // the merge (see below): it is looked up there, by binary search.
   std::vector<uint32_t> star2;
   std::vector<StarEntry> star, starOfKept;
   std::array<size_t, 5> begin{}, beginOfKept{};

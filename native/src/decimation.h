@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "kdmesh/kdmesh.h"
+#include "large_array.h"
 #include "simplex_store.h"
 
 namespace kdmesh {
@@ -28,6 +29,12 @@ struct InputSummary {
   // The sorted distinct labels of the kept simplices; empty without labels.
   std::vector<int32_t> labelTable;
 };
+
+// For each of the tuples of `arity` distinct vertex ids below `vertexCount`
+// (tuple i at tuples[i * arity]), the index of the first tuple with the same
+// vertex set: i itself for the first. Linear in the tuples but for sorting
+// those that share their least vertex.
+LargeArray<uint32_t> firstWithSameVertices(const LargeArray<uint32_t>& tuples, int arity, uint32_t vertexCount);
 
 // Fills `store` with the closure of the input's simplices, with vertex i of
 // the input renamed ids[i]. Listed simplices are flagged kMeaningful (their

@@ -3,11 +3,10 @@
 //
 // Simplices of dimension 1..3 live in flat per-dimension pools. A simplex
 // stores its vertices as an oriented tuple (for triangles and tetrahedra the
-// tuple order, corrected by a `flipped` bit, is the orientation); a hash
-// index finds a simplex from its vertex set in any order. Each vertex has,
-// per dimension, a singly linked list of the incidence slots (simplex,
-// position in tuple) that hold it, so a star is walked without scanning the
-// complex. Killed simplices leave their slots in the lists of other vertices;
+// tuple order, corrected by a `flipped` bit, is the orientation). Each
+// vertex has, per dimension, a singly linked list of the incidence slots
+// (simplex, position in tuple) that hold it, so a star is walked without
+// scanning the complex. Killed simplices leave their slots in the lists of other vertices;
 // walks drop them as they pass.
 #pragma once
 
@@ -47,10 +46,10 @@ class SimplexStore {
     kUndecided = 8,   // orientation not yet decoded in the current split
   };
 
-  // `indexed`: keep the hash index that find() needs. The decoder never
-  // looks a simplex up by its vertices, so it saves the index's time and
-  // memory.
-  void reset(uint32_t vertexCapacity, bool indexed);
+  // `killable`: simplices may be killed (the encoder's decimation); walks
+  // then skip killed ones. The decoder's store only grows, and its walks
+  // need not look at the flags.
+  void reset(uint32_t vertexCapacity, bool killable);
   // Gives every simplex a label (index into the label table); only stores
   // of labelled complexes pay for them. Call after reset(), before add().
   void enableLabels() { labelled_ = true; }
@@ -67,15 +66,7 @@ class SimplexStore {
   // kNoSimplex when the pool is at capacity. `label` is kept by labelled
   // stores only.
   uint32_t add(int dimension, const uint32_t* vertices, uint8_t flags, uint32_t label = kNoLabel);
-  // Index of the live simplex with this vertex set, or kNoSimplex (indexed
-  // stores only, before dropIndex()).
-  uint32_t find(int dimension, const uint32_t* vertices) const;
-  // Frees the hash index and stops keeping it, for an indexed store that
-  // needs no more find(): killed simplices stay killed and walks still
-  // skip them.
-  void dropIndex();
-  // Indexed stores only: the walks of an unindexed store (the decoder's)
-  // do not look at the flags, since nothing is killed there.
+  // Killable stores only.
   void kill(int dimension, uint32_t simplex);
   // Replaces vertex `from` of a simplex by `to` (which it must not contain),
   // keeping the orientation. Lists are left alone: the split and merge
@@ -110,9 +101,9 @@ class SimplexStore {
     while (*link != kNoSimplex) {
       const uint32_t slot = *link;
       const uint32_t simplex = slot / arity;
-      // Only the encoder's indexed store kills simplices; the decoder's walk
-      // need not load their flags.
-      if (indexed_ && !(pool.flags[simplex] & kAlive)) {
+      // Only the encoder's store kills simplices; the decoder's walk need
+      // not load their flags.
+      if (killable_ && !(pool.flags[simplex] & kAlive)) {
         *link = pool.next[slot];
         continue;
       }
@@ -129,7 +120,7 @@ class SimplexStore {
     const uint32_t arity = uint32_t(dimension + 1);
     for (uint32_t slot = heads_[dimension][vertex]; slot != kNoSimplex; slot = pool.next[slot]) {
       const uint32_t simplex = slot / arity;
-      if (indexed_ && !(pool.flags[simplex] & kAlive)) continue;
+      if (killable_ && !(pool.flags[simplex] & kAlive)) continue;
       if constexpr (std::is_same_v<decltype(visit(simplex, 0u)), bool>) {
         if (visit(simplex, slot - simplex * arity)) return true;
       } else {
@@ -149,12 +140,12 @@ class SimplexStore {
     const uint32_t* next;      // next slot per slot
     const uint32_t* vertices;  // arity per simplex
     const uint8_t* flags;
-    bool skipDead;  // indexed stores kill simplices; their walks skip them
+    bool skipDead;  // killable stores' walks skip killed simplices
     bool alive(uint32_t simplex) const { return !skipDead || (flags[simplex] & kAlive); }
   };
   Lists lists(int dimension) const {
     const Pool& pool = pool_[dimension];
-    return {heads_[dimension].data(), pool.next.data(), pool.vertices.data(), pool.flags.data(), indexed_};
+    return {heads_[dimension].data(), pool.next.data(), pool.vertices.data(), pool.flags.data(), killable_};
   }
 
   // Empties `vertex`'s list of `dimension` without touching the simplices;
@@ -163,34 +154,18 @@ class SimplexStore {
   void link(int dimension, uint32_t simplex, uint32_t position);
 
  private:
-  // A simplex and the hash of its vertex set, so that probes compare hashes
-  // before they load a simplex's vertices. Entries are never erased: one
-  // whose simplex was killed or has changed vertices since is skipped by
-  // find(), and the table is rebuilt from the live simplices when it fills
-  // (erasing entries had cost more than skipping them).
-  struct IndexSlot {
-    uint32_t simplex = kNoSimplex;
-    uint32_t hash = 0;
-  };
   struct Pool {
     LargeArray<uint32_t> vertices;  // dimension + 1 per simplex
     LargeArray<uint32_t> next;      // next slot in the vertex list, per slot
     LargeArray<uint8_t> flags;
     LargeArray<uint32_t> labels;    // labelled stores only
-    LargeArray<IndexSlot> table;    // open addressing; empty: no index kept
-    uint32_t tableEntries = 0;       // live or not
     uint32_t capacity = 0xffffffffu;
   };
-
-  static uint32_t hashOf(int dimension, const uint32_t* vertices);
-  bool sameSet(int dimension, uint32_t simplex, const uint32_t* vertices) const;
-  void insertIndex(int dimension, uint32_t simplex);
-  void rebuildIndex(int dimension);
 
   std::array<Pool, 4> pool_;                      // [0] unused
   std::array<LargeArray<uint32_t>, 4> heads_;    // [0] unused
   std::array<uint32_t, 4> live_{};
-  bool indexed_ = true;  // simplices may be killed
+  bool killable_ = true;
   bool labelled_ = false;
 };
 
