@@ -129,7 +129,7 @@ LargeArray<uint32_t> firstWithSameVertices(const LargeArray<uint32_t>& tuples, i
 }
 
 Status buildInputComplex(const Complex& complex, const std::vector<uint32_t>& ids,
-                         SimplexStore& store, InputSummary& summary) {
+                         const std::vector<uint32_t>& kdRank, SimplexStore& store, InputSummary& summary) {
   const size_t n = complex.vertexCount();
   summary = InputSummary{};
   store.reset(uint32_t(n), true);
@@ -186,19 +186,32 @@ Status buildInputComplex(const Complex& complex, const std::vector<uint32_t>& id
   }
   for (int d = 3; d >= 1; --d) {
     Candidates& mine = candidates[size_t(d)];
+    const size_t arity = size_t(d + 1);
     const LargeArray<uint32_t> first = firstWithSameVertices(mine.tuples, d + 1, uint32_t(n));
+    for (size_t c = 0; c < first.size(); ++c)
+      if (first[c] != c && mine.listed[c] != kNoSimplex)
+        ++(mine.listed[first[c]] != kNoSimplex ? summary.repairs.duplicate : summary.repairs.redundant)[size_t(d)];
+    // The kept simplices by the kd-tree rank of their first vertex in that
+    // order (a counting sort): the simplices of a cell, at any level of the
+    // tree, then lie together in the pools, where the decimation walks
+    // them cell by cell, fine to coarse.
+    auto leastRank = [&](size_t c) {
+      uint32_t least = kdRank[mine.tuples[c * arity]];
+      for (size_t i = 1; i < arity; ++i) least = std::min(least, kdRank[mine.tuples[c * arity + i]]);
+      return least;
+    };
+    std::vector<uint32_t> start(n + 1, 0);
+    for (size_t c = 0; c < first.size(); ++c)
+      if (first[c] == c) ++start[size_t(leastRank(c)) + 1];
+    for (size_t r = 0; r < n; ++r) start[r + 1] += start[r];
+    LargeArray<uint32_t> addOrder(start[n]);
+    for (size_t c = 0; c < first.size(); ++c)
+      if (first[c] == c) addOrder[start[leastRank(c)]++] = uint32_t(c);
     // The pool at its final size at once, not grown by doubling.
-    uint32_t kept = 0;
-    for (size_t c = 0; c < first.size(); ++c) kept += first[c] == c;
-    store.setCapacity(d, kNoSimplex, kept);
-    for (size_t c = 0; c < first.size(); ++c) {
+    store.setCapacity(d, kNoSimplex, uint32_t(addOrder.size()));
+    for (const uint32_t c : addOrder) {
       const uint32_t listed = mine.listed[c];
-      if (first[c] != c) {
-        if (listed != kNoSimplex)
-          ++(mine.listed[first[c]] != kNoSimplex ? summary.repairs.duplicate : summary.repairs.redundant)[size_t(d)];
-        continue;
-      }
-      const uint32_t* tuple = &mine.tuples[c * size_t(d + 1)];
+      const uint32_t* tuple = &mine.tuples[c * arity];
       if (listed == kNoSimplex) {
         store.add(d, tuple, 0);
         continue;

@@ -40,9 +40,10 @@ LargeArray<uint32_t> firstWithSameVertices(const LargeArray<uint32_t>& tuples, i
 // the input renamed ids[i]. Listed simplices are flagged kMeaningful (their
 // orientation is data); faces added by the closure are not. With labels,
 // listed simplices get the index of theirs in summary.labelTable, faces
-// added by the closure kNoLabel.
+// added by the closure kNoLabel. kdRank[id]: the rank of vertex `id` in the
+// kd-tree's order, which lays the pools out cell by cell.
 Status buildInputComplex(const Complex& complex, const std::vector<uint32_t>& ids,
-                         SimplexStore& store, InputSummary& summary);
+                         const std::vector<uint32_t>& kdRank, SimplexStore& store, InputSummary& summary);
 
 // Per split, in the decoder's order, one record byte per star entry of the
 // split vertex (see split_record in vertex_split.h).

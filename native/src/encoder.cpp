@@ -334,9 +334,11 @@ EncodeResult encodeStream(const Complex& complex, const EncodeOptions& options, 
       inputOfId.resize(ids.size());
       for (uint32_t input = 0; input < ids.size(); ++input) inputOfId[ids[input]] = input;
     }
+    std::vector<uint32_t> kdRank(ids.size());
+    for (uint32_t r = 0; r < order.vertices.size(); ++r) kdRank[ids[order.vertices[r]]] = r;
     SimplexStore store;
     InputSummary summary;
-    if (result.status = buildInputComplex(complex, ids, store, summary); !result.status.ok())
+    if (result.status = buildInputComplex(complex, ids, kdRank, store, summary); !result.status.ok())
       return result;
     result.repairs = summary.repairs;
     connectivity = summary.maxDimension > 0;
