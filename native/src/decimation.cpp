@@ -87,7 +87,8 @@ LargeArray<uint32_t> firstWithSameVerticesOf(const LargeArray<uint32_t>& tuples,
     return v;
   };
   std::vector<uint32_t> start(size_t(vertexCount) + 1, 0);
-  for (size_t i = 0; i < count; ++i) ++start[size_t(*std::min_element(&tuples[i * kArity], &tuples[i * kArity] + kArity)) + 1];
+  for (size_t i = 0; i < count; ++i)
+    ++start[size_t(*std::min_element(&tuples[i * kArity], &tuples[i * kArity] + kArity)) + 1];
   for (size_t v = 0; v < vertexCount; ++v) start[v + 1] += start[v];
   LargeArray<Record> records(count);
   {
