@@ -6,8 +6,8 @@
 // tuple order, corrected by a `flipped` bit, is the orientation). Each
 // vertex has, per dimension, a singly linked list of the incidence slots
 // (simplex, position in tuple) that hold it, so a star is walked without
-// scanning the complex. Killed simplices leave their slots in the lists of other vertices;
-// walks drop them as they pass.
+// scanning the complex. Killed simplices leave their slots in the lists of
+// other vertices; walks drop them as they pass.
 #pragma once
 
 #include <array>
