@@ -239,7 +239,7 @@ export class Decoder {
   }
 
   /**
-   * Header fields once the header (at most 87 bytes) has arrived, else null;
+   * Header fields once the header (at most 88 bytes) has arrived, else null;
    * with `labels`, the stream's label table once it has arrived (it follows
    * the header and the attribute table): an Int32Array of the stream's
    * distinct simplex labels, ascending, where a label's index is the same at

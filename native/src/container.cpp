@@ -14,11 +14,13 @@ constexpr size_t kOffVersion = 4, kOffHeaderBytes = 6;
 static_assert(kHeaderPrefixBytes == kOffHeaderBytes + 1, "header prefix");
 // The fixed bytes, ten 32-bit varints (the body size's has at most 9 bytes),
 // grid parameters (float32 mode's are three 32-bit varints) and checksum.
-static_assert(kMaxHeaderBytes == kHeaderPrefixBytes + 2 + 9 * 5 + 9 + 20 + 4, "header size");
+static_assert(kMaxHeaderBytes == kHeaderPrefixBytes + 3 + 9 * 5 + 9 + 20 + 4, "header size");
 // The mode byte: quantization in bit 0, whether simplices carry labels in
 // bit 1, the highest dimension in bits 2-3, the number of vertex attributes
-// in bits 4-7.
+// in bits 4-7. The coding byte: bit 0 set when one-vertex splits and cell
+// counts are not predicted from the neighbourhood; the other bits are 0.
 static_assert(kMaxAttributes == 15, "the attribute count has four bits");
+constexpr uint8_t kCodingWithoutNeighbourhood = 1;
 
 void put16(uint8_t* p, uint16_t v) {
   p[0] = uint8_t(v);
@@ -174,6 +176,7 @@ size_t writeHeader(const Header& h, uint8_t* out) {
   uint8_t* at = out + kHeaderPrefixBytes;
   *at++ = uint8_t(uint8_t(h.quantization) | h.labelled << 1 | h.maxDimension << 2 | h.attributeCount << 4);
   *at++ = h.bits;
+  *at++ = h.neighbourhoodPredictions ? 0 : kCodingWithoutNeighbourhood;
   at += putVarint(at, h.vertexCount);
   for (const uint32_t count : h.simplexCounts) at += putVarint(at, count);
   for (const uint32_t max : h.gridMax) at += putVarint(at, max);
@@ -215,13 +218,16 @@ Status readHeader(const uint8_t* in, size_t size, const DecoderLimits& limits, H
   h.headerBytes = uint8_t(size);
   const uint8_t* at = in + kHeaderPrefixBytes;
   const uint8_t* const end = in + size - 4;
-  if (end - at < 2) return corrupt("truncated fields");
+  if (end - at < 3) return corrupt("truncated fields");
   const uint8_t mode = *at++;
   h.quantization = Quantization(mode & 1);
   h.labelled = mode >> 1 & 1;
   h.maxDimension = uint8_t(mode >> 2 & 3);
   h.attributeCount = uint8_t(mode >> 4);
   h.bits = *at++;
+  const uint8_t coding = *at++;
+  if (coding & ~kCodingWithoutNeighbourhood) return corrupt("unknown coding flags");
+  h.neighbourhoodPredictions = !(coding & kCodingWithoutNeighbourhood);
   bool ok = true;
   auto u32 = [&](uint32_t& field) {
     uint64_t v = 0;

@@ -76,6 +76,9 @@ struct Decoder::State {
   // Connectivity: the complex on the current cells. Levels past the last
   // geometric one split cells of coincident vertices in halves.
   bool connectivity = false;
+  // One-vertex splits and cell counts predicted from the neighbourhood
+  // (streams with connectivity, unless coded for fast decoding).
+  bool predictions = false;
   // Vertices have ids (and coincident ones their own levels) in streams
   // with connectivity or attributes.
   bool named = false;
@@ -134,10 +137,11 @@ struct Decoder::State {
     schedule.emplace(header);
     dequantizer.emplace(header);
     connectivity = header.maxDimension > 0;
+    predictions = connectivity && header.neighbourhoodPredictions;
     named = connectivity || header.attributeCount > 0;
     attributeTableRead = header.attributeCount == 0;
     labelTableRead = !header.labelled;
-    counts.emplace(schedule->levels, connectivity);
+    counts.emplace(schedule->levels, predictions);
     coder.setMeasuring(options.measureCost);
     const Cell root{{0, 0, 0}, header.vertexCount, 0, 0, 0};
     (header.vertexCount == 1 ? singles : cells).push_back(root);
@@ -225,7 +229,7 @@ struct Decoder::State {
     const bool geometric = level < schedule->levels;
     const uint32_t firstHalf =
         geometric ? counts->code(coder, population, level, cell.parentOneSided, 0,
-                                 connectivity ? predictor->countContext(cell.vertex, level, cell.parentOneSided)
+                                 predictions ? predictor->countContext(cell.vertex, level, cell.parentOneSided)
                                               : CountContext{})
                   : population / 2;
     const bool oneSided = firstHalf == 0 || firstHalf == population;
@@ -330,9 +334,9 @@ struct Decoder::State {
     for (size_t i = begin; i < end; ++i) {
       Cell& cell = singles[i];
       const bool upperHalf =
-          connectivity ? !predictor->codeSingle(coder, *counts, cell.vertex, level,
-                                                cell.parentOneSided, false)
-                       : !counts->codeSingle(coder, level, cell.parentOneSided, false);
+          predictions ? !predictor->codeSingle(coder, *counts, cell.vertex, level,
+                                               cell.parentOneSided, false)
+                      : !counts->codeSingle(coder, level, cell.parentOneSided, false);
       cell.prefix[axis] = cell.prefix[axis] << 1 | upperHalf;
       cell.parentOneSided = 1;
     }

@@ -362,7 +362,9 @@ EncodeResult encodeStream(const Complex& complex, const EncodeOptions& options, 
   result.cost.attributeBits.assign(complex.attributes.size(), 0.0);
   ChunkWriter chunks(body, options.chunkBytes);
   RangeEncoder& coder = chunks.coder();
-  CountCoder counts(schedule.levels, connectivity);
+  header.neighbourhoodPredictions = !options.fastDecode;
+  const bool predictions = connectivity && header.neighbourhoodPredictions;
+  CountCoder counts(schedule.levels, predictions);
   SimplexStore forward;
   forward.reset(header.vertexCount, false);
   PositionPredictor predictor(schedule, forward);
@@ -386,6 +388,7 @@ EncodeResult encodeStream(const Complex& complex, const EncodeOptions& options, 
     size_t& splitIndex;
     double& connectivityBits;
     bool connectivity;
+    bool predictions;  // one-vertex splits and cell counts from the neighbourhood
     std::function<void(const char*, double)> report;
     std::vector<LevelCost>& levels;
     const std::vector<VertexAttribute>& attributes;
@@ -406,7 +409,7 @@ EncodeResult encodeStream(const Complex& complex, const EncodeOptions& options, 
       }
       if (geometric)
         counts.code(coder, population, level, parentOneSided, firstHalf,
-                    connectivity ? predictor.countContext(kept, level, parentOneSided) : CountContext{});
+                    predictions ? predictor.countContext(kept, level, parentOneSided) : CountContext{});
       if (connectivity && added != kNoSimplex) {
         const double before = coder.cost();
         splitter.split(coder, kept, added, level, splitBalance(population, firstHalf, geometric),
@@ -446,7 +449,7 @@ EncodeResult encodeStream(const Complex& complex, const EncodeOptions& options, 
       if (connectivity) predictor.place(id, prefix, level);
     }
     void single(int level, bool parentOneSided, bool inFirstHalf, uint32_t id) {
-      if (connectivity)
+      if (predictions)
         predictor.codeSingle(coder, counts, id, level, parentOneSided, inFirstHalf);
       else
         counts.codeSingle(coder, level, parentOneSided, inFirstHalf);
@@ -458,7 +461,7 @@ EncodeResult encodeStream(const Complex& complex, const EncodeOptions& options, 
     }
   } coding{header,      schedule,          counts,     coder,       chunks,     splitter,
            forward,     predictor,         records,    splitIndex,  connectivityBits, connectivity,
-           report,      result.cost.levels, complex.attributes, held, order.vertices, attributeCoder,
+           predictions,            report,      result.cost.levels, complex.attributes, held, order.vertices, attributeCoder,
            result.cost.attributeBits, inputOfId};
   traverseKdTree(order.keys, schedule, connectivity || named, coding);
   if (afterGeometry) {

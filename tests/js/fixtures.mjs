@@ -194,8 +194,9 @@ export function makeFixtures() {
   for (const [name, complex] of Object.entries(shapes)) {
     const input = join(workDir, `${name}.ply`);
     writePly(input, complex);
-    for (const mode of [['--bits', '12'], ['--exact']]) {
-      const key = `${name}${mode.length === 1 ? '-exact' : '-12'}`;
+    const modes = { '-12': ['--bits', '12'], '-exact': ['--exact'], '-fast': ['--bits', '12', '--fast-decode'] };
+    for (const [suffix, mode] of Object.entries(modes)) {
+      const key = `${name}${suffix}`;
       const kdm = join(workDir, `${key}.kdm`);
       execFileSync(cli, ['encode', input, '-o', kdm, '--chunk-bytes', '256', '-q', ...mode]);
       fixtures[key] = { kdm, bytes: readFileSync(kdm) };

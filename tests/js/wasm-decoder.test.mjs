@@ -38,8 +38,17 @@ test('whole streams decode exactly as the native decoder does', async () => {
   }
 });
 
+test('the header says whether a stream predicts from the neighbourhood', async () => {
+  for (const [name, expected] of [['torus-12', true], ['torus-fast', false], ['tetrahedra-fast', false]]) {
+    const decoder = await createDecoder();
+    decoder.push(fixtures[name].bytes.subarray(0, 200));
+    assert.equal(decoder.header.neighbourhoodPredictions, expected, name);
+    decoder.dispose();
+  }
+});
+
 test('prefixes decode exactly as the native decoder does', async () => {
-  for (const name of ['torus-12', 'tetrahedra-exact', 'mixed-12', 'cloud-12', 'triceratops.off']) {
+  for (const name of ['torus-12', 'tetrahedra-exact', 'mixed-12', 'cloud-12', 'triceratops.off', 'torus-fast', 'tetrahedra-fast']) {
     const { kdm, bytes } = fixtures[name];
     for (const fraction of [0.02, 0.1, 0.35, 0.7]) {
       const cut = Math.max(100, Math.floor(bytes.length * fraction));
@@ -164,7 +173,7 @@ function crc32(bytes) {
   return (crc ^ 0xffffffff) >>> 0;
 }
 
-// The header's fields (docs/FORMAT.md): after the 9 fixed bytes, varints for
+// The header's fields (docs/FORMAT.md): after the 10 fixed bytes, varints for
 // the vertex count, four simplex counts, three grid extents, the body size
 // and the chunk count, then the quantization parameters and a CRC-32.
 function readVarints(bytes, at, count) {
@@ -188,9 +197,9 @@ function writeVarint(out, value) {
 
 function forgeHeader(honest, change) {
   const size = honest[6];
-  const { values, at } = readVarints(honest, 9, 10);
+  const { values, at } = readVarints(honest, 10, 10);
   change(values);
-  const out = [...honest.subarray(0, 9)];
+  const out = [...honest.subarray(0, 10)];
   for (const value of values) writeVarint(out, value);
   out.push(...honest.subarray(at, size - 4));
   out[6] = out.length + 4;

@@ -391,6 +391,22 @@ TEST_F(CliTest, InfoPrintsHeaderFieldsAndBitsPerVertex) {
   EXPECT_NE(exact.out.find("\"quantization\": \"float32\""), std::string::npos) << exact.out;
 }
 
+// --fast-decode codes a mesh without neighbourhood predictions: the header
+// says so, and the stream decodes to the same model as the default one.
+TEST_F(CliTest, FastDecodeStreamsSayHowTheyPredictAndDecodeAlike) {
+  writeModel("torus.ply", torusMesh(20, 30));
+  runOk("-q encode torus.ply -o default.kdm --bits 12");
+  runOk("-q encode torus.ply -o fast.kdm --bits 12 --fast-decode");
+  EXPECT_NE(runOk("info default.kdm").out.find("predictions     from the decoded neighbourhood\n"), std::string::npos);
+  EXPECT_NE(runOk("info fast.kdm").out.find("predictions     from level statistics (--fast-decode)\n"),
+            std::string::npos);
+  EXPECT_NE(runOk("info --json fast.kdm").out.find("\"neighbourhoodPredictions\": false"), std::string::npos);
+  runOk("-q decode default.kdm -o default.ply");
+  runOk("-q decode fast.kdm -o fast.ply");
+  EXPECT_EQ(canonicalForm(readModel("fast.ply")), canonicalForm(readModel("default.ply")));
+  EXPECT_NE(runOk("encode --help").out.find("--fast-decode"), std::string::npos);
+}
+
 // --levels adds a row per kd-tree level, whose last byte estimate is
 // about the stream's size.
 TEST_F(CliTest, InfoLevelsListsEveryLevel) {

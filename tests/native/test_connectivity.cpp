@@ -88,6 +88,51 @@ TEST(Connectivity, PredictorsRunAlikeOnBothSides) {
   }
 }
 
+// A stream coded for fast decoding predicts no one-vertex split and no
+// cell count from the neighbourhood, on either side, and still round-trips
+// every kind of complex, in every prefix.
+TEST(Connectivity, FastDecodeStreamsRoundTripWithoutNeighbourhoodPredictions) {
+  EncodeOptions fast = exact();
+  fast.fastDecode = true;
+  Complex mixed = tetrahedralBlock(1, 9);
+  const std::vector<float> extra = uniformCloud(8, 11, 3.f);
+  mixed.positions.insert(mixed.positions.end(), extra.begin(), extra.end());
+  mixed.triangles.insert(mixed.triangles.end(), {0, 8, 9, 9, 10, 11});
+  mixed.edges.insert(mixed.edges.end(), {11, 12, 7, 13});
+  mixed.points.push_back(14);
+  const Complex shapes[] = {torusMesh(12, 20), gridWithHoles(16), tetrahedralBlock(4, 3), mixed,
+                            randomComplex(77, 40, 60)};
+  for (const Complex& shape : shapes) {
+    EncodeResult encoded;
+    const Complex output = roundTrip(shape, fast, &encoded);
+    EXPECT_EQ(output.vertexCount(), shape.vertexCount());
+    EXPECT_EQ(canonicalForm(output), canonicalForm(shape));
+    Decoder decoder;
+    ASSERT_TRUE(decoder.push(encoded.bytes.data(), encoded.bytes.size()).ok());
+    EXPECT_FALSE(decoder.header().neighbourhoodPredictions);
+    EXPECT_GT(encoded.statistics.vertexSplits, 0u);
+    EXPECT_EQ(encoded.statistics.positionPredictions + encoded.statistics.countPredictions, 0u);
+    EXPECT_EQ(decoder.statistics().positionPredictions + decoder.statistics().countPredictions, 0u);
+    EXPECT_EQ(decoder.statistics().vertexSplits, encoded.statistics.vertexSplits);
+  }
+  for (uint32_t seed = 1; seed <= 40; ++seed) {
+    const Complex c = randomComplex(seed, 4 + int(seed % 23), 1 + int(seed % 41));
+    SCOPED_TRACE(seed);
+    EXPECT_EQ(canonicalForm(roundTrip(c, fast)), canonicalForm(c));
+    if (HasFailure()) break;
+  }
+  // The predictions are what the default stream saves bits with.
+  EncodeOptions grid;
+  grid.bits = 12;
+  EncodeOptions gridFast = grid;
+  gridFast.fastDecode = true;
+  const Complex torus = torusMesh(24, 40);
+  EXPECT_LT(encode(torus, grid).bytes.size(), encode(torus, gridFast).bytes.size());
+  fast.chunkBytes = 64;
+  expectPrefixesAreProjections(torusMesh(14, 22), fast);
+  expectPrefixesAreProjections(tetrahedralBlock(3, 5), fast);
+}
+
 TEST(Connectivity, OpenMeshWithHoles) { expectExactRoundTrip(gridWithHoles(18)); }
 
 TEST(Connectivity, NonManifoldEdgesAndVertexTouchingSheets) {

@@ -8,6 +8,7 @@
 
 #include "complexes.h"
 #include "container.h"
+#include "crc32.h"
 #include "mutations.h"
 #include "shapes.h"
 #include "test_support.h"
@@ -437,6 +438,19 @@ TEST(Stream, HostileHeadersAreRefusedBeforeAnyAllocation) {
     Decoder d5;
     EXPECT_EQ(d5.push(resized, sizeof resized).code, ErrorCode::CorruptHeader) << change;
   }
+
+  // Coding flags this decoder does not know, under a valid checksum.
+  for (const uint8_t flags : {uint8_t(2), uint8_t(0x81)}) {
+    h = validHeader();
+    size = writeHeader(h, buffer);
+    buffer[kHeaderPrefixBytes + 2] = flags;
+    const uint32_t checksum = crc32(buffer, size - 4);
+    for (int i = 0; i < 4; ++i) buffer[size - 4 + size_t(i)] = uint8_t(checksum >> (8 * i));
+    Decoder unknown;
+    const Status s = unknown.push(buffer, size);
+    EXPECT_EQ(s.code, ErrorCode::CorruptHeader) << int(flags);
+    EXPECT_NE(s.message.find("unknown coding flags"), std::string::npos) << s.message;
+  }
 }
 
 // Every field's largest value fits the header's largest size, and every
@@ -448,6 +462,7 @@ TEST(Stream, HeadersRoundTripWithTheirLargestValues) {
   for (const Quantization mode : {Quantization::Grid, Quantization::Float32}) {
     Header h;
     h.quantization = mode;
+    h.neighbourhoodPredictions = mode == Quantization::Float32;
     h.bits = mode == Quantization::Grid ? 30 : 32;
     h.vertexCount = (1u << 31) - 1;
     h.maxDimension = 3;
@@ -470,6 +485,7 @@ TEST(Stream, HeadersRoundTripWithTheirLargestValues) {
     EXPECT_EQ(back.gridMax, h.gridMax);
     EXPECT_EQ(back.bodyBytes, h.bodyBytes);
     EXPECT_EQ(back.chunkCount, h.chunkCount);
+    EXPECT_EQ(back.neighbourhoodPredictions, h.neighbourhoodPredictions);
     if (mode == Quantization::Grid) {
       EXPECT_EQ(back.origin, h.origin);
       EXPECT_EQ(back.step, h.step);

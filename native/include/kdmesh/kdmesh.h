@@ -190,6 +190,10 @@ struct Header {
   // Whether edges, triangles and tetrahedra carry labels; the label table
   // (the distinct labels) follows the attribute table.
   bool labelled = false;
+  // Whether one-vertex splits and cell counts are predicted from the
+  // decoded neighbourhood of their vertex (the default) or from the cell
+  // statistics of their level alone (EncodeOptions::fastDecode).
+  bool neighbourhoodPredictions = true;
 
   // Float32 mode with float64 residuals (bits 64): the kd-tree codes each
   // coordinate's float32 rounding, and two hidden attributes at the end of
@@ -206,7 +210,7 @@ struct Header {
 
 // The header that starts every stream is at most this long; its first
 // kHeaderPrefixBytes say how long it is.
-constexpr size_t kMaxHeaderBytes = 87;
+constexpr size_t kMaxHeaderBytes = 88;
 constexpr size_t kHeaderPrefixBytes = 7;
 
 // ---------------------------------------------------------------------------
@@ -244,6 +248,13 @@ struct EncodeOptions {
   // growing by a quarter each up to this size) so that a viewer can show
   // something early and refine it often.
   size_t chunkBytes = 16 * 1024;
+  // Predict one-vertex splits and cell counts from the statistics of their
+  // kd-tree level alone instead of from the decoded neighbourhood: the
+  // decoder skips the neighbourhood walk and the mixing of every such
+  // decision, the larger share of its work on meshes, at the price of a
+  // larger stream (docs/BENCHMARKS.md has both). Point clouds, which have
+  // no neighbourhood, code the same either way.
+  bool fastDecode = false;
   // Called now and then during long encodes; may be empty.
   std::function<void(const EncodeProgress&)> progress;
   // Working memory encode() may take, in bytes (0: no limit). A complex
