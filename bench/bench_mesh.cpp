@@ -6,7 +6,9 @@
 //
 // Prints a Markdown table: bits per vertex (connectivity / geometry / total)
 // for kdmesh, total for Draco, warm median encode/decode times, throughput
-// in M triangles/s, kdmesh/Draco time ratios, and kdmesh's operator counts.
+// in M triangles/s, kdmesh/Draco time ratios, the same for streams encoded
+// for fast decoding (EncodeOptions::fastDecode), and kdmesh's operator
+// counts.
 #include <cstdio>
 #include <string>
 #include <vector>
@@ -58,7 +60,7 @@ int main(int argc, char** argv) {
               "Draco -cl 10 encode Mtri/s | Draco -cl 10 decode Mtri/s | encode time ratio | "
               "decode time ratio |\n");
   std::printf("|---|---:|---:|---:|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
-  std::string operators;
+  std::string operators, fast;
   for (const std::string& path : args.models) {
     const kdmesh::Complex model = bench::readModel(path);
     const double n = double(model.vertexCount()), triangles = double(model.simplexCount(2));
@@ -66,17 +68,25 @@ int main(int argc, char** argv) {
     for (const int bits : args.bits) {
       kdmesh::EncodeOptions options;
       options.bits = bits;
-      kdmesh::EncodeResult encoded;
-      Measurement ours;
-      ours.encodeSeconds = medianSeconds(args.runs, [&] { encoded = kdmesh::encode(model, options); });
-      if (!encoded.status.ok()) fail("kdmesh encode: " + encoded.status.message);
-      ours.bytes = encoded.bytes.size();
-      kdmesh::Complex decoded;
-      ours.decodeSeconds = medianSeconds(args.runs, [&] {
-        const kdmesh::Status s = kdmesh::decode(encoded.bytes.data(), encoded.bytes.size(), decoded);
-        if (!s.ok()) fail("kdmesh decode: " + s.message);
-      });
-      if (decoded.simplexCount(2) != model.simplexCount(2)) fail("kdmesh decoded a different triangle count");
+      // Encodes and decodes the model with `options`, warm medians.
+      auto measureOurs = [&](const kdmesh::EncodeOptions& o, kdmesh::EncodeResult& encoded) {
+        Measurement m;
+        m.encodeSeconds = medianSeconds(args.runs, [&] { encoded = kdmesh::encode(model, o); });
+        if (!encoded.status.ok()) fail("kdmesh encode: " + encoded.status.message);
+        m.bytes = encoded.bytes.size();
+        kdmesh::Complex decoded;
+        m.decodeSeconds = medianSeconds(args.runs, [&] {
+          const kdmesh::Status s = kdmesh::decode(encoded.bytes.data(), encoded.bytes.size(), decoded);
+          if (!s.ok()) fail("kdmesh decode: " + s.message);
+        });
+        if (decoded.simplexCount(2) != model.simplexCount(2)) fail("kdmesh decoded a different triangle count");
+        return m;
+      };
+      kdmesh::EncodeResult encoded, encodedFast;
+      const Measurement ours = measureOurs(options, encoded);
+      kdmesh::EncodeOptions fastOptions = options;
+      fastOptions.fastDecode = true;
+      const Measurement oursFast = measureOurs(fastOptions, encodedFast);
       // The decoder checks a CRC-32 over every chunk payload: its share of decoding.
       uint32_t sink = 0;
       const double crcSeconds = medianSeconds(args.runs, [&] { sink ^= kdmesh::crc32(encoded.bytes.data(), encoded.bytes.size()); });
@@ -93,6 +103,15 @@ int main(int argc, char** argv) {
                   triangles / draco10.encodeSeconds / 1e6, triangles / draco10.decodeSeconds / 1e6,
                   ours.encodeSeconds / draco10.encodeSeconds, ours.decodeSeconds / draco10.decodeSeconds);
       std::fflush(stdout);
+      char row[512];
+      std::snprintf(row, sizeof row, "| %s | %d | %.2f / %.2f / %.2f | %.3f | %.3f | %.2f | %.2f | %.2f | %.2f | %.2f |\n",
+                    bench::baseName(path).c_str(), bits, encodedFast.cost.connectivityBits / n,
+                    encodedFast.cost.geometryBits / n, 8.0 * double(oursFast.bytes) / n,
+                    double(oursFast.bytes) / double(ours.bytes), double(oursFast.bytes) / double(draco10.bytes),
+                    triangles / oursFast.encodeSeconds / 1e6, triangles / oursFast.decodeSeconds / 1e6,
+                    oursFast.encodeSeconds / draco10.encodeSeconds, oursFast.decodeSeconds / draco10.decodeSeconds,
+                    ours.decodeSeconds / oursFast.decodeSeconds);
+      fast += row;
       const kdmesh::ConnectivityStatistics& st = encoded.statistics;
       char line[512];
       std::snprintf(line, sizeof line,
@@ -107,6 +126,11 @@ int main(int argc, char** argv) {
       operators += line;
     }
   }
+  std::printf("\nEncoded with --fast-decode (no neighbourhood predictions), against the default stream and Draco "
+              "-cl 10 above:\n\n| model | bits | conn / geom / total bpv | size vs default | size vs Draco -cl 10 | "
+              "encode Mtri/s | decode Mtri/s | encode time ratio vs Draco | decode time ratio vs Draco | decode "
+              "speed-up vs default |\n");
+  std::printf("|---|---:|---|---:|---:|---:|---:|---:|---:|---:|\n%s", fast.c_str());
   std::printf("\n| model | bits | merges (n - 1) | of which edge expansions | share | edge codes 1/2/3/4 | "
               "triangle codes 1/2/3/4 | orientation mispredicted |\n");
   std::printf("|---|---:|---:|---:|---:|---|---|---:|\n%s", operators.c_str());

@@ -1,7 +1,8 @@
 // Time to first and final render of the dragon at a simulated 10 Mbit/s in
 // headless chromium: kdmesh's progressive viewer against a Draco file of the
 // same model loaded with three.js's DRACOLoader (whose first render is its
-// full download plus decode). Also lists main-thread long tasks.
+// full download plus decode), and the same viewer on a stream encoded with
+// --fast-decode. Also lists main-thread long tasks.
 //
 //   node bench/browser-bench.mjs [--throttle KBPS] [--runs N]
 //
@@ -27,6 +28,8 @@ const dragon = join(root, 'build', 'models', 'dragon_vrip.ply');
 // The CLI that bench/run.sh builds alongside the WebAssembly decoder it
 // rebuilds: build/'s may be older, and its streams of another format version.
 execFileSync(join(root, 'build-bench', 'kdmesh'), ['encode', dragon, '-o', join(models, 'dragon.kdm'), '--bits', '12', '-q']);
+execFileSync(join(root, 'build-bench', 'kdmesh'),
+  ['encode', dragon, '-o', join(models, 'dragon-fast.kdm'), '--bits', '12', '--fast-decode', '-q']);
 execFileSync('draco_encoder', ['-i', dragon, '-o', join(models, 'dragon.drc'), '-qp', '12', '-cl', '10'], { stdio: 'ignore' });
 
 const server = await startServer({ port: 0, root: models, host: '127.0.0.1' });
@@ -47,18 +50,22 @@ const row = (name, first, final, refinements, tasks) =>
   `| ${name} | ${ms(first)} | ${ms(final)} | ${refinements} | ${Math.max(0, ...tasks)} ms | ${tasks.length} |`;
 console.log(`| dragon at ${throttle / 1000} Mbit/s | first render | final render | refinements | longest main-thread task | long tasks (> 50 ms) |`);
 console.log('|---|---:|---:|---:|---:|---:|');
-const all = { kdmesh: [], draco: [] };
+const all = { kdmesh: [], fast: [], draco: [] };
+const viewer = (model) => run(`${base}/?model=${model}&throttle=${throttle}`,
+  () => window.kdmeshViewer.state === 'error' || window.kdmeshViewer.finalRenderMs !== null,
+  () => ({ ...window.kdmeshViewer }));
 for (let i = 1; i <= runs; ++i) {
-  const kdmesh = await run(`${base}/?model=dragon.kdm&throttle=${throttle}`,
-    () => window.kdmeshViewer.state === 'error' || window.kdmeshViewer.finalRenderMs !== null,
-    () => ({ ...window.kdmeshViewer }));
+  const kdmesh = await viewer('dragon.kdm');
+  const fast = await viewer('dragon-fast.kdm');
   const draco = await run(`${base}/draco-bench.html?model=models/dragon.drc%3Fthrottle%3D${throttle}`,
     () => window.dracoBench.state === 'complete',
     () => ({ ...window.dracoBench }));
   const run_ = runs > 1 ? `, run ${i}` : '';
   console.log(row(`kdmesh (.kdm, progressive)${run_}`, kdmesh.firstRenderMs, kdmesh.finalRenderMs, kdmesh.refinements, kdmesh.longTasks));
+  console.log(row(`kdmesh --fast-decode${run_}`, fast.firstRenderMs, fast.finalRenderMs, fast.refinements, fast.longTasks));
   console.log(row(`three.js DRACOLoader (.drc -cl 10)${run_}`, draco.renderMs, draco.renderMs, 1, draco.longTasks));
   all.kdmesh.push(kdmesh);
+  all.fast.push(fast);
   all.draco.push(draco);
 }
 await browser.close();
@@ -74,5 +81,6 @@ if (runs > 1) {
       ` (longest ${longest} ms)`);
   };
   summary('kdmesh', all.kdmesh, (r) => r.firstRenderMs, (r) => r.finalRenderMs);
+  summary('kdmesh --fast-decode', all.fast, (r) => r.firstRenderMs, (r) => r.finalRenderMs);
   summary('DRACOLoader', all.draco, (r) => r.renderMs, (r) => r.renderMs);
 }

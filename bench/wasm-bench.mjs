@@ -1,11 +1,12 @@
 // WebAssembly decoder benchmark, in one Node process: kdmesh's WASM decoder
 // against the native decoder (its in-process time, as `kdmesh decode`
 // reports it) and against draco3d (Draco's own WASM decoder from npm) on the
-// same models at the same quantization. Warm medians of 5 runs.
+// same models at the same quantization, each model's stream encoded by
+// default and with --fast-decode. Warm medians of 5 runs.
 //
 //   node bench/wasm-bench.mjs [--quick] MODEL...
 import { execFileSync, spawnSync } from 'node:child_process';
-import { mkdtempSync, readFileSync, rmSync } from 'node:fs';
+import { existsSync, mkdtempSync, readFileSync, rmSync } from 'node:fs';
 import { tmpdir } from 'node:os';
 import { basename, join } from 'node:path';
 import draco3d from 'draco3d';
@@ -67,15 +68,18 @@ function dracoDecode(bytes) {
 console.log(`| model | triangles | kdmesh bytes | kdmesh WASM decode s | native CLI decode s (fresh process) | WASM / native | ` +
   `WASM MB/s | WASM Mtri/s | Draco -cl 10 bytes | draco3d decode s | kdmesh WASM / draco3d | first snapshot after |`);
 console.log('|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|');
-for (const model of models) {
-  const kdm = join(work, `${basename(model)}.kdm`);
+for (const [model, coding] of models.flatMap((m) => [[m, []], [m, ['--fast-decode']]])) {
+  const name = [basename(model), ...coding].join(' ');
+  const kdm = join(work, `${basename(model)}${coding.length ? '-fast' : ''}.kdm`);
   const drc = join(work, `${basename(model)}.drc`);
-  execFileSync(cli, ['encode', model, '-o', kdm, '--bits', '12', '-q']);
-  // draco_encoder reads PLY, OBJ and STL: hand it a lossless PLY copy.
-  const ply = join(work, `${basename(model)}.ply`);
-  execFileSync(cli, ['encode', model, '-o', `${ply}.kdm`, '--exact', '-q']);
-  execFileSync(cli, ['decode', `${ply}.kdm`, '-o', ply, '-q']);
-  execFileSync('draco_encoder', ['-i', ply, '-o', drc, '-qp', '12', '-cl', '10'], { stdio: 'ignore' });
+  execFileSync(cli, ['encode', model, '-o', kdm, '--bits', '12', '-q', ...coding]);
+  if (!existsSync(drc)) {
+    // draco_encoder reads PLY, OBJ and STL: hand it a lossless PLY copy.
+    const ply = join(work, `${basename(model)}.ply`);
+    execFileSync(cli, ['encode', model, '-o', `${ply}.kdm`, '--exact', '-q']);
+    execFileSync(cli, ['decode', `${ply}.kdm`, '-o', ply, '-q']);
+    execFileSync('draco_encoder', ['-i', ply, '-o', drc, '-qp', '12', '-cl', '10'], { stdio: 'ignore' });
+  }
   const bytes = readFileSync(kdm);
   const dracoBytes = readFileSync(drc);
   let triangles = 0;
@@ -90,7 +94,7 @@ for (const model of models) {
     if (decoder.progress.chunksApplied > 0) firstAt = at;
   }
   decoder.dispose();
-  console.log(`| ${basename(model)} | ${triangles} | ${bytes.length} | ${wasm.toFixed(3)} | ${native.toFixed(3)} | ` +
+  console.log(`| ${name} | ${triangles} | ${bytes.length} | ${wasm.toFixed(3)} | ${native.toFixed(3)} | ` +
     `${(wasm / native).toFixed(2)} | ${(bytes.length / wasm / 1e6).toFixed(2)} | ${(triangles / wasm / 1e6).toFixed(2)} | ` +
     `${dracoBytes.length} | ${draco.toFixed(3)} | ${(wasm / draco).toFixed(2)} | ` +
     `${firstAt} B (${((100 * firstAt) / bytes.length).toFixed(2)} %) |`);
