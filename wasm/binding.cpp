@@ -66,7 +66,7 @@ void visitHeader(const kdmesh::Header& h, Field&& field) {
   field("depth", Values{double(h.depth())});  // kd-tree levels: the last level of a complete stream
   field("attributeCount", Values{double(h.attributeCount)});
   field("labelled:bool", Values{h.labelled ? 1.0 : 0.0});
-  field("neighbourhoodPredictions:bool", Values{h.neighbourhoodPredictions ? 1.0 : 0.0});
+  field("fastDecode:bool", Values{h.fastDecode ? 1.0 : 0.0});
 }
 
 template <class Field>

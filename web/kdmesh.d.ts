@@ -49,9 +49,8 @@ export interface Header {
   attributeCount: number;
   /** Whether edges, triangles and tetrahedra carry integer labels (Model.labels). */
   labelled: boolean;
-  /** Whether the stream predicts refinements from the decoded neighbourhood (false: encoded with
-   * --fast-decode, a larger stream that decodes faster). */
-  neighbourhoodPredictions: boolean;
+  /** Whether the stream was encoded with --fast-decode (a larger stream that decodes faster). */
+  fastDecode: boolean;
   /** The stream's label table, once it has arrived (right after the header and the attribute table): its
    * distinct labels, ascending. A label's index here is the same at every level (kdmesh/three's
    * materialIndex). null until then; empty for streams without labels. */

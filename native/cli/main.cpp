@@ -413,7 +413,7 @@ int runInfo(const std::string& input, bool json, bool perLevel) {
     std::printf("  \"quantization\": \"%s\",\n  \"bits\": %u,\n", grid ? "grid" : h.float64() ? "float64" : "float32",
                 unsigned(h.bits));
     std::printf("  \"axisBits\": [%d, %d, %d],\n", h.axisBits(0), h.axisBits(1), h.axisBits(2));
-    std::printf("  \"neighbourhoodPredictions\": %s,\n", h.neighbourhoodPredictions ? "true" : "false");
+    std::printf("  \"fastDecode\": %s,\n", h.fastDecode ? "true" : "false");
     if (grid)
       std::printf("  \"origin\": [%s, %s, %s],\n  \"step\": %s,\n", jsonNumber(h.origin[0]).c_str(),
                   jsonNumber(h.origin[1]).c_str(), jsonNumber(h.origin[2]).c_str(),
@@ -478,8 +478,8 @@ int runInfo(const std::string& input, bool json, bool perLevel) {
                 h.float64() ? ", then residuals" : "");
   std::printf("kd-tree levels  %d\n", h.depth());
   if (h.maxDimension > 0)
-    std::printf("predictions     %s\n", h.neighbourhoodPredictions ? "from the decoded neighbourhood"
-                                                                    : "from level statistics (--fast-decode)");
+    std::printf("predictions     %s\n", h.fastDecode ? "along the split axis (--fast-decode)"
+                                                      : "from the decoded neighbourhood");
   double attributeBits = 0;
   for (const double bits : cost.attributeBits) attributeBits += bits;
   std::printf("bits/vertex     %.3f total: %.3f geometry, %.3f connectivity, %.3f attributes, %.3f labels, "
@@ -601,8 +601,9 @@ int main(int argc, char** argv) {
                      "come after its positions, predicted from its triangles")
       ->check(CLI::Range(2, 16));
   encode->add_flag("--fast-decode", encodeArgs.fastDecode,
-                   "Predict each refinement from its kd-tree level's statistics, not from the decoded "
-                   "neighbourhood: meshes decode 2-3x faster, in a larger stream (docs/BENCHMARKS.md)");
+                   "Predict vertices from their neighbours along the split axis only, not from the whole "
+                   "decoded neighbourhood: meshes decode about twice as fast, in a larger stream "
+                   "(docs/BENCHMARKS.md)");
   encode->add_flag("--points-only", encodeArgs.pointsOnly,
                    "Drop edges, triangles and tetrahedra and encode the vertices");
   encode->add_flag("--weld", encodeArgs.weld,

@@ -17,10 +17,10 @@ static_assert(kHeaderPrefixBytes == kOffHeaderBytes + 1, "header prefix");
 static_assert(kMaxHeaderBytes == kHeaderPrefixBytes + 3 + 9 * 5 + 9 + 20 + 4, "header size");
 // The mode byte: quantization in bit 0, whether simplices carry labels in
 // bit 1, the highest dimension in bits 2-3, the number of vertex attributes
-// in bits 4-7. The coding byte: bit 0 set when one-vertex splits and cell
-// counts are not predicted from the neighbourhood; the other bits are 0.
+// in bits 4-7. The coding byte: bit 0 set for a stream coded for fast
+// decoding; the other bits are 0.
 static_assert(kMaxAttributes == 15, "the attribute count has four bits");
-constexpr uint8_t kCodingWithoutNeighbourhood = 1;
+constexpr uint8_t kFastDecodeBit = 1;
 
 void put16(uint8_t* p, uint16_t v) {
   p[0] = uint8_t(v);
@@ -176,7 +176,7 @@ size_t writeHeader(const Header& h, uint8_t* out) {
   uint8_t* at = out + kHeaderPrefixBytes;
   *at++ = uint8_t(uint8_t(h.quantization) | h.labelled << 1 | h.maxDimension << 2 | h.attributeCount << 4);
   *at++ = h.bits;
-  *at++ = h.neighbourhoodPredictions ? 0 : kCodingWithoutNeighbourhood;
+  *at++ = h.fastDecode ? kFastDecodeBit : 0;
   at += putVarint(at, h.vertexCount);
   for (const uint32_t count : h.simplexCounts) at += putVarint(at, count);
   for (const uint32_t max : h.gridMax) at += putVarint(at, max);
@@ -226,8 +226,8 @@ Status readHeader(const uint8_t* in, size_t size, const DecoderLimits& limits, H
   h.attributeCount = uint8_t(mode >> 4);
   h.bits = *at++;
   const uint8_t coding = *at++;
-  if (coding & ~kCodingWithoutNeighbourhood) return corrupt("unknown coding flags");
-  h.neighbourhoodPredictions = !(coding & kCodingWithoutNeighbourhood);
+  if (coding & ~kFastDecodeBit) return corrupt("unknown coding flags");
+  h.fastDecode = coding & kFastDecodeBit;
   bool ok = true;
   auto u32 = [&](uint32_t& field) {
     uint64_t v = 0;

@@ -76,8 +76,8 @@ struct Decoder::State {
   // Connectivity: the complex on the current cells. Levels past the last
   // geometric one split cells of coincident vertices in halves.
   bool connectivity = false;
-  // One-vertex splits and cell counts predicted from the neighbourhood
-  // (streams with connectivity, unless coded for fast decoding).
+  // Cell counts predicted from the neighbourhood (streams with
+  // connectivity, unless coded for fast decoding).
   bool predictions = false;
   // Vertices have ids (and coincident ones their own levels) in streams
   // with connectivity or attributes.
@@ -137,7 +137,7 @@ struct Decoder::State {
     schedule.emplace(header);
     dequantizer.emplace(header);
     connectivity = header.maxDimension > 0;
-    predictions = connectivity && header.neighbourhoodPredictions;
+    predictions = connectivity && !header.fastDecode;
     named = connectivity || header.attributeCount > 0;
     attributeTableRead = header.attributeCount == 0;
     labelTableRead = !header.labelled;
@@ -161,7 +161,7 @@ struct Decoder::State {
         const uint32_t cap = uint32_t(std::min<uint64_t>(caps[size_t(d)], 0xffffffffu));
         store.setCapacity(d, cap, uint32_t(std::min<uint64_t>(cap, plausible)));
       }
-      predictor.emplace(*schedule, store);
+      predictor.emplace(*schedule, store, header.fastDecode);
       splitter.emplace(store, *predictor);
       predictor->place(0, root.prefix, 0);
     }
@@ -334,9 +334,9 @@ struct Decoder::State {
     for (size_t i = begin; i < end; ++i) {
       Cell& cell = singles[i];
       const bool upperHalf =
-          predictions ? !predictor->codeSingle(coder, *counts, cell.vertex, level,
-                                               cell.parentOneSided, false)
-                      : !counts->codeSingle(coder, level, cell.parentOneSided, false);
+          connectivity ? !predictor->codeSingle(coder, *counts, cell.vertex, level,
+                                                cell.parentOneSided, false)
+                       : !counts->codeSingle(coder, level, cell.parentOneSided, false);
       cell.prefix[axis] = cell.prefix[axis] << 1 | upperHalf;
       cell.parentOneSided = 1;
     }

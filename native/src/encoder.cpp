@@ -362,12 +362,12 @@ EncodeResult encodeStream(const Complex& complex, const EncodeOptions& options, 
   result.cost.attributeBits.assign(complex.attributes.size(), 0.0);
   ChunkWriter chunks(body, options.chunkBytes);
   RangeEncoder& coder = chunks.coder();
-  header.neighbourhoodPredictions = !options.fastDecode;
-  const bool predictions = connectivity && header.neighbourhoodPredictions;
+  header.fastDecode = options.fastDecode;
+  const bool predictions = connectivity && !header.fastDecode;  // cell counts from the neighbourhood
   CountCoder counts(schedule.levels, predictions);
   SimplexStore forward;
   forward.reset(header.vertexCount, false);
-  PositionPredictor predictor(schedule, forward);
+  PositionPredictor predictor(schedule, forward, header.fastDecode);
   VertexSplitter splitter(forward, predictor);
   if (header.labelled) {
     forward.enableLabels();
@@ -388,7 +388,7 @@ EncodeResult encodeStream(const Complex& complex, const EncodeOptions& options, 
     size_t& splitIndex;
     double& connectivityBits;
     bool connectivity;
-    bool predictions;  // one-vertex splits and cell counts from the neighbourhood
+    bool predictions;  // cell counts from the neighbourhood
     std::function<void(const char*, double)> report;
     std::vector<LevelCost>& levels;
     const std::vector<VertexAttribute>& attributes;
@@ -449,7 +449,7 @@ EncodeResult encodeStream(const Complex& complex, const EncodeOptions& options, 
       if (connectivity) predictor.place(id, prefix, level);
     }
     void single(int level, bool parentOneSided, bool inFirstHalf, uint32_t id) {
-      if (predictions)
+      if (connectivity)
         predictor.codeSingle(coder, counts, id, level, parentOneSided, inFirstHalf);
       else
         counts.codeSingle(coder, level, parentOneSided, inFirstHalf);

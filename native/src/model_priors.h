@@ -38,7 +38,8 @@ namespace kdmesh {
   X(EdgeCodesByRun, kEdgeCodeByRunPriors, 1980)                    \
   X(VertexCodes, kVertexCodePriors, 36)                            \
   X(OneVertexByRefinement, kOneVertexByRefinementPriors, 8192)     \
-  X(CellCountsByRefinement, kCellCountByRefinementPriors, 4096)
+  X(CellCountsByRefinement, kCellCountByRefinementPriors, 4096)  \
+  X(OneVertexAlongAxis, kOneVertexAlongAxisPriors, 4096)
 
 #define KDMESH_FAMILY_NAME(name, priors, ...) name,
 #define KDMESH_FAMILY_SIZE(name, priors, size) size_t{size},

@@ -230,7 +230,7 @@ int centroidBucket(double t) {
 
 }  // namespace
 
-PositionPredictor::PositionPredictor(const SplitSchedule& schedule, const SimplexStore& store)
+PositionPredictor::PositionPredictor(const SplitSchedule& schedule, const SimplexStore& store, bool fastDecode)
     : axis_(schedule.axis),
       store_(store),
       models_(size_t(kJointValenceClasses) * kOutsideClasses * kScaleClasses * kTiltClasses * kPlaneBuckets *
@@ -239,6 +239,8 @@ PositionPredictor::PositionPredictor(const SplitSchedule& schedule, const Simple
       centroidModels_(size_t(kValenceClasses) * kScaleClasses * kCentroidBuckets),
       parallelogramModels_(size_t(kPlaneBuckets) * kSpreadClasses * kParallelogramBuckets),
       refinementModels_(kRefinementModels),
+      alongAxisModels_(kAlongAxisModels),
+      fastDecode_(fastDecode),
       mixer_(kElongationGroups * kScaleClasses * kAgreementClasses, mixerPriors(MixerFamily::OneVertexSplits)),
       parallelogramMixer_(kParallelogramBuckets, mixerPriors(MixerFamily::OneVertexByParallelogram)),
       planeAndCentroidMixer_(kCentroidBuckets * kPlaneBuckets, mixerPriors(MixerFamily::OneVertexByPlaneAndCentroid)) {
@@ -497,6 +499,31 @@ bool PositionPredictor::contextsOf(uint32_t vertex, int level, SingleContexts& c
   c.refinement = refinementClass(around, f.mirrored, true) * 2 + (tilt >= 2);
   c.parallelogramOdds.fast = c.parallelogramOdds.slow =
       f.hasParallelogram ? parallelogramOdds(f.parallelogramOffset, f.parallelogramSpread) : kProbabilityOne / 2;
+  return true;
+}
+
+bool PositionPredictor::alongAxisContext(uint32_t vertex, int level, int& context, bool& mirrored) {
+  static_assert(kAlongAxisModels == kFamilySize[int(ModelFamily::OneVertexAlongAxis)]);
+  if (vertex >= store_.vertexCapacity() || vertex >= places_.size()) return false;
+  const int axis = axis_[size_t(level)];
+  const double inverseHalfWidth = inverseHalfWidths_[size_t(level)];
+  const double atAxis = places_[vertex].centre[axis];
+  const Place* places = places_.data();
+  Neighbourhood around{};
+  double sum = 0;  // of the neighbours' offsets along the axis, in half widths
+  uint32_t count = 0;
+  store_.forEachIncident(1, vertex, [&](uint32_t edge, uint32_t position) {
+    const double offset = (places[store_.vertices(1, edge)[1 - position]].centre[axis] - atAxis) * inverseHalfWidth;
+    ++around.alongAxis[size_t(alongBin(offset))];
+    sum += offset;
+    ++count;
+  });
+  if (count == 0) return false;
+  ++positionPredictions_;
+  mirrored = sum < 0;
+  const double centroid = std::fabs(sum) / double(count);
+  const int bucket = centroid < 0.25 ? 0 : centroid < 0.75 ? 1 : centroid < 1.5 ? 2 : 3;
+  context = refinementClass(around, mirrored, false) * kAlongAxisCentroidBuckets + bucket;
   return true;
 }
 

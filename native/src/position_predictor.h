@@ -51,6 +51,12 @@
 // offset over their deviation, unbucketed, and as a sixth a model chosen by
 // the refinement class; the split of a cell of several vertices gets
 // classes for CountCoder.
+//
+// A stream coded for fast decoding (EncodeOptions::fastDecode) keeps only
+// what one pass over the vertex's edges gives: each one-vertex split is
+// coded with one model chosen by the refinement class and where the
+// neighbours' centroid lies along the split axis, mirrored by the
+// centroid's side; cells of several vertices get no class.
 #pragma once
 
 #include <algorithm>
@@ -102,8 +108,9 @@ class PositionPredictor {
   // shape, the parallelogram odds and the refinement class's model.
   static constexpr int kSingleInputs = 6;
 
-  // `store`: the complex the predictions read, as it changes.
-  PositionPredictor(const SplitSchedule& schedule, const SimplexStore& store);
+  // `store`: the complex the predictions read, as it changes;
+  // `fastDecode`: the stream is coded for fast decoding (see above).
+  PositionPredictor(const SplitSchedule& schedule, const SimplexStore& store, bool fastDecode);
 
   // The vertex's cell is now the one at `level` with these leading
   // coordinate bits.
@@ -133,8 +140,11 @@ class PositionPredictor {
                   bool parentOneSided, bool inFirstHalf) {
     SingleContexts c;
     bool first;
-    if (!contextsOf(vertex, level, c)) {
+    int alongAxis = 0;
+    if (fastDecode_ ? !alongAxisContext(vertex, level, alongAxis, c.mirrored) : !contextsOf(vertex, level, c)) {
       first = counts.codeSingle(coder, level, parentOneSided, inFirstHalf);
+    } else if (fastDecode_) {
+      first = coder.bit(alongAxisModels_[size_t(alongAxis)], inFirstHalf != c.mirrored) != c.mirrored;
     } else {
       const bool bit = codeWithMixers(
           coder, std::array<Mixer<kSingleInputs>*, 3>{&mixer_, &parallelogramMixer_, &planeAndCentroidMixer_},
@@ -186,6 +196,7 @@ class PositionPredictor {
     visit(ModelFamily::OneVertexByCentroid, centroidModels_.data());
     visit(ModelFamily::OneVertexByParallelogram, parallelogramModels_.data());
     visit(ModelFamily::OneVertexByRefinement, refinementModels_.data());
+    visit(ModelFamily::OneVertexAlongAxis, alongAxisModels_.data());
   }
   template <class Visit>
   void forEachMixer(Visit&& visitMixer) const {
@@ -286,6 +297,12 @@ class PositionPredictor {
     BitModel parallelogramOdds;
   };
   bool contextsOf(uint32_t vertex, int level, SingleContexts& contexts);
+  // Fast decoding: the model of a one-vertex split from the vertex's edges,
+  // and whether it is mirrored; false for a vertex in no edge.
+  bool alongAxisContext(uint32_t vertex, int level, int& context, bool& mirrored);
+  // The refinement class without far halves, by centroid bucket.
+  static constexpr int kAlongAxisCentroidBuckets = 4;
+  static constexpr size_t kAlongAxisModels = size_t(CountContext::kRefinementClasses) * kAlongAxisCentroidBuckets;
   // One-vertex refinement models: the class with far halves, by tilt.
   static constexpr size_t kRefinementModels = size_t(CountContext::kRefinementClasses) * 4 * 2;
   // The neighbourhood of a vertex in no simplex: its proxy as its one
@@ -314,7 +331,9 @@ class PositionPredictor {
   LargeArray<uint32_t> acrossSlots_;
   // The parallelogram predictions of one gather(), and their deviations.
   std::vector<double> predictions_;
-  std::vector<BitModel> models_, planeModels_, centroidModels_, parallelogramModels_, refinementModels_;
+  std::vector<BitModel> models_, planeModels_, centroidModels_, parallelogramModels_, refinementModels_,
+      alongAxisModels_;
+  bool fastDecode_;
   Mixer<kSingleInputs> mixer_, parallelogramMixer_, planeAndCentroidMixer_;
   uint64_t countPredictions_ = 0;
   uint64_t positionPredictions_ = 0;

@@ -2,7 +2,8 @@
 // training mesh at 12 bits and averages, model by model, the final
 // probability of the slow estimator, weighted by how often the model was
 // used in that mesh (capped, so that no mesh dominates), then writes
-// model_priors.inc. Models the meshes used fewer than kMinWeight times in
+// model_priors.inc. Each mesh is also encoded for fast decoding; the
+// families only that coding uses learn from it. Models the meshes used fewer than kMinWeight times in
 // all start at 1/2. The mixers' starting weights are averaged the same way,
 // weight vector by weight vector; one that no mesh used keeps its compiled
 // value.
@@ -58,11 +59,13 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "usage: %s [--only NAMES] OUTPUT.inc MESH...\n", argv[0]);
     return 2;
   }
-  std::vector<std::vector<double>> sum(kdmesh::kModelFamilies), weight(kdmesh::kModelFamilies);
-  for (int f = 0; f < kdmesh::kModelFamilies; ++f) {
-    sum[size_t(f)].assign(kdmesh::kFamilySize[size_t(f)], 0);
-    weight[size_t(f)].assign(kdmesh::kFamilySize[size_t(f)], 0);
-  }
+  // Per coding (default, fast decoding), family and model.
+  std::vector<std::vector<double>> sum[2], weight[2];
+  for (int coding = 0; coding < 2; ++coding)
+    for (int f = 0; f < kdmesh::kModelFamilies; ++f) {
+      sum[coding].emplace_back(kdmesh::kFamilySize[size_t(f)], 0.0);
+      weight[coding].emplace_back(kdmesh::kFamilySize[size_t(f)], 0.0);
+    }
   // Per mixer family: weighted sums of each weight, and the weight of each vector.
   std::vector<std::vector<double>> mixerSum(kdmesh::kMixerFamilies), mixerWeight(kdmesh::kMixerFamilies);
   for (int f = 0; f < kdmesh::kMixerFamilies; ++f) {
@@ -76,25 +79,31 @@ int main(int argc, char** argv) {
       std::fprintf(stderr, "%s: %s\n", argv[i], s.message.c_str());
       return 1;
     }
-    kdmesh::EncodeOptions options;
-    options.bits = 12;
-    kdmesh::TrainedModels models;
-    const kdmesh::EncodeResult result = kdmesh::encode(complex, options, &models);
-    if (!result.status.ok() || models.families[0].empty()) {
-      std::fprintf(stderr, "%s: %s\n", argv[i], result.status.ok() ? "no connectivity" : result.status.message.c_str());
-      return 1;
-    }
-    std::fprintf(stderr, "%s: %zu vertices, %.3f bits/vertex\n", argv[i], complex.vertexCount(),
-                 8.0 * double(result.bytes.size()) / double(complex.vertexCount()));
-    for (int f = 0; f < kdmesh::kModelFamilies; ++f)
-      for (size_t m = 0; m < kdmesh::kFamilySize[size_t(f)]; ++m) {
-        const kdmesh::BitModel& model = models.families[size_t(f)][m];
-        // Primed models start with some observations already counted.
-        const double used =
-            std::min<double>(kMaxWeight, std::max(0, int(model.seen) - int(kdmesh::kPriorObservations)));
-        sum[size_t(f)][m] += used * model.slow;
-        weight[size_t(f)][m] += used;
+    kdmesh::TrainedModels models;  // of the default coding, whose mixers are learned
+    for (int coding = 0; coding < 2; ++coding) {
+      kdmesh::EncodeOptions options;
+      options.bits = 12;
+      options.fastDecode = coding == 1;
+      kdmesh::TrainedModels trained;
+      const kdmesh::EncodeResult result = kdmesh::encode(complex, options, &trained);
+      if (!result.status.ok() || trained.families[0].empty()) {
+        std::fprintf(stderr, "%s: %s\n", argv[i], result.status.ok() ? "no connectivity" : result.status.message.c_str());
+        return 1;
       }
+      std::fprintf(stderr, "%s%s: %zu vertices, %.3f bits/vertex\n", argv[i], coding ? " (fast decoding)" : "",
+                   complex.vertexCount(), 8.0 * double(result.bytes.size()) / double(complex.vertexCount()));
+      for (int f = 0; f < kdmesh::kModelFamilies; ++f)
+        for (size_t m = 0; m < trained.families[size_t(f)].size(); ++m) {  // empty: a family the coding lacks
+          const kdmesh::BitModel& model = trained.families[size_t(f)][m];
+          // Primed models start with some observations already counted.
+          const double used =
+              std::min<double>(kMaxWeight, std::max(0, int(model.seen) - int(kdmesh::kPriorObservations)));
+          sum[coding][size_t(f)][m] += used * model.slow;
+          weight[coding][size_t(f)][m] += used;
+        }
+      if (coding == 1) continue;
+      models = std::move(trained);
+    }
     for (int f = 0; f < kdmesh::kMixerFamilies; ++f) {
       const size_t inputs = kdmesh::kMixerInputs[size_t(f)];
       for (size_t set = 0; set < kdmesh::kMixerSets[size_t(f)]; ++set) {
@@ -115,11 +124,14 @@ int main(int argc, char** argv) {
   for (int f = 0; f < kdmesh::kModelFamilies; ++f) {
     std::vector<kdmesh::BitModel> compiled(kdmesh::kFamilySize[size_t(f)]);
     kdmesh::primeModels(kdmesh::ModelFamily(f), compiled.data());
+    // The default coding's statistics, unless it never used the family.
+    const std::vector<double>& defaultWeight = weight[0][size_t(f)];
+    const int coding = std::all_of(defaultWeight.begin(), defaultWeight.end(), [](double w) { return w == 0; });
     std::vector<uint8_t> codes;
     for (size_t m = 0; m < kdmesh::kFamilySize[size_t(f)]; ++m) {
-      const double w = weight[size_t(f)][m];
+      const double w = weight[coding][size_t(f)][m];
       const int prior = !retrain[size_t(f)] ? int(compiled[m].slow)
-                        : w >= kMinWeight ? int(sum[size_t(f)][m] / w + 0.5)
+                        : w >= kMinWeight ? int(sum[coding][size_t(f)][m] / w + 0.5)
                                         : int(kdmesh::kProbabilityOne / 2);
       codes.push_back(kdmesh::priorCode(uint32_t(prior)));
     }

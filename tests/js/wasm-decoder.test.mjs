@@ -38,11 +38,11 @@ test('whole streams decode exactly as the native decoder does', async () => {
   }
 });
 
-test('the header says whether a stream predicts from the neighbourhood', async () => {
-  for (const [name, expected] of [['torus-12', true], ['torus-fast', false], ['tetrahedra-fast', false]]) {
+test('the header says whether a stream is coded for fast decoding', async () => {
+  for (const [name, expected] of [['torus-12', false], ['torus-fast', true], ['tetrahedra-fast', true]]) {
     const decoder = await createDecoder();
     decoder.push(fixtures[name].bytes.subarray(0, 200));
-    assert.equal(decoder.header.neighbourhoodPredictions, expected, name);
+    assert.equal(decoder.header.fastDecode, expected, name);
     decoder.dispose();
   }
 });

@@ -24,7 +24,7 @@ test('the header and progress records read as the native CLI reports them', asyn
     vertexCount: info.vertexCount, maxDimension: info.maxDimension, simplexCounts: info.simplexCounts,
     quantization: info.quantization, bits: info.bits, step: info.step, totalBytes: info.bytes, chunkCount: info.chunks.length,
     depth: info.axisBits.reduce((sum, bits) => sum + bits), attributeCount: info.attributes.length,
-    labelled: info.labels.distinct > 0, neighbourhoodPredictions: info.neighbourhoodPredictions, labels: new Int32Array(0),
+    labelled: info.labels.distinct > 0, fastDecode: info.fastDecode, labels: new Int32Array(0),
   });
   assert.equal(early.bytesReceived, 2000);
   assert.equal(early.bytesExpected, info.bytes);

@@ -398,9 +398,9 @@ TEST_F(CliTest, FastDecodeStreamsSayHowTheyPredictAndDecodeAlike) {
   runOk("-q encode torus.ply -o default.kdm --bits 12");
   runOk("-q encode torus.ply -o fast.kdm --bits 12 --fast-decode");
   EXPECT_NE(runOk("info default.kdm").out.find("predictions     from the decoded neighbourhood\n"), std::string::npos);
-  EXPECT_NE(runOk("info fast.kdm").out.find("predictions     from level statistics (--fast-decode)\n"),
+  EXPECT_NE(runOk("info fast.kdm").out.find("predictions     along the split axis (--fast-decode)\n"),
             std::string::npos);
-  EXPECT_NE(runOk("info --json fast.kdm").out.find("\"neighbourhoodPredictions\": false"), std::string::npos);
+  EXPECT_NE(runOk("info --json fast.kdm").out.find("\"fastDecode\": true"), std::string::npos);
   runOk("-q decode default.kdm -o default.ply");
   runOk("-q decode fast.kdm -o fast.ply");
   EXPECT_EQ(canonicalForm(readModel("fast.ply")), canonicalForm(readModel("default.ply")));

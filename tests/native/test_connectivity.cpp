@@ -88,10 +88,11 @@ TEST(Connectivity, PredictorsRunAlikeOnBothSides) {
   }
 }
 
-// A stream coded for fast decoding predicts no one-vertex split and no
-// cell count from the neighbourhood, on either side, and still round-trips
-// every kind of complex, in every prefix.
-TEST(Connectivity, FastDecodeStreamsRoundTripWithoutNeighbourhoodPredictions) {
+// A stream coded for fast decoding predicts one-vertex splits from the
+// neighbours along the split axis and no cell count from the neighbourhood,
+// on both sides alike, and still round-trips every kind of complex, in
+// every prefix.
+TEST(Connectivity, FastDecodeStreamsRoundTripWithAxialPredictionsAlone) {
   EncodeOptions fast = exact();
   fast.fastDecode = true;
   Complex mixed = tetrahedralBlock(1, 9);
@@ -109,11 +110,16 @@ TEST(Connectivity, FastDecodeStreamsRoundTripWithoutNeighbourhoodPredictions) {
     EXPECT_EQ(canonicalForm(output), canonicalForm(shape));
     Decoder decoder;
     ASSERT_TRUE(decoder.push(encoded.bytes.data(), encoded.bytes.size()).ok());
-    EXPECT_FALSE(decoder.header().neighbourhoodPredictions);
-    EXPECT_GT(encoded.statistics.vertexSplits, 0u);
-    EXPECT_EQ(encoded.statistics.positionPredictions + encoded.statistics.countPredictions, 0u);
-    EXPECT_EQ(decoder.statistics().positionPredictions + decoder.statistics().countPredictions, 0u);
-    EXPECT_EQ(decoder.statistics().vertexSplits, encoded.statistics.vertexSplits);
+    EXPECT_TRUE(decoder.header().fastDecode);
+    const ConnectivityStatistics& mine = encoded.statistics;
+    const ConnectivityStatistics theirs = decoder.statistics();
+    EXPECT_GT(mine.vertexSplits, 0u);
+    EXPECT_GT(mine.positionPredictions, 0u);
+    EXPECT_EQ(mine.countPredictions + mine.parallelogramPredictions + mine.proxyPredictions, 0u);
+    EXPECT_EQ(theirs.countPredictions + theirs.parallelogramPredictions + theirs.proxyPredictions, 0u);
+    EXPECT_EQ(theirs.positionPredictions, mine.positionPredictions);
+    EXPECT_EQ(theirs.refinedNeighbourPredictions, mine.refinedNeighbourPredictions);
+    EXPECT_EQ(theirs.vertexSplits, mine.vertexSplits);
   }
   for (uint32_t seed = 1; seed <= 40; ++seed) {
     const Complex c = randomComplex(seed, 4 + int(seed % 23), 1 + int(seed % 41));
@@ -121,7 +127,7 @@ TEST(Connectivity, FastDecodeStreamsRoundTripWithoutNeighbourhoodPredictions) {
     EXPECT_EQ(canonicalForm(roundTrip(c, fast)), canonicalForm(c));
     if (HasFailure()) break;
   }
-  // The predictions are what the default stream saves bits with.
+  // The full neighbourhood is what the default stream saves bits with.
   EncodeOptions grid;
   grid.bits = 12;
   EncodeOptions gridFast = grid;

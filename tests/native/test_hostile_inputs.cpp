@@ -149,7 +149,7 @@ TEST(FuzzSeeds, DecoderSeedsDecodeAndCoverEveryTable) {
     grid |= decoder.header().quantization == Quantization::Grid;
     connectivity |= c.hasSimplices();
     labelled |= decoder.header().labelled;
-    fastDecode |= c.hasSimplices() && !decoder.header().neighbourhoodPredictions;
+    fastDecode |= c.hasSimplices() && decoder.header().fastDecode;
     float64 |= decoder.header().float64() && !c.positions64.empty();
     for (const VertexAttribute& a : c.attributes) {
       exactAttribute |= a.quantization.kind == AttributeQuantization::Exact;

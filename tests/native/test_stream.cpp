@@ -462,7 +462,7 @@ TEST(Stream, HeadersRoundTripWithTheirLargestValues) {
   for (const Quantization mode : {Quantization::Grid, Quantization::Float32}) {
     Header h;
     h.quantization = mode;
-    h.neighbourhoodPredictions = mode == Quantization::Float32;
+    h.fastDecode = mode == Quantization::Float32;
     h.bits = mode == Quantization::Grid ? 30 : 32;
     h.vertexCount = (1u << 31) - 1;
     h.maxDimension = 3;
@@ -485,7 +485,7 @@ TEST(Stream, HeadersRoundTripWithTheirLargestValues) {
     EXPECT_EQ(back.gridMax, h.gridMax);
     EXPECT_EQ(back.bodyBytes, h.bodyBytes);
     EXPECT_EQ(back.chunkCount, h.chunkCount);
-    EXPECT_EQ(back.neighbourhoodPredictions, h.neighbourhoodPredictions);
+    EXPECT_EQ(back.fastDecode, h.fastDecode);
     if (mode == Quantization::Grid) {
       EXPECT_EQ(back.origin, h.origin);
       EXPECT_EQ(back.step, h.step);

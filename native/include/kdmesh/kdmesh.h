@@ -190,10 +190,8 @@ struct Header {
   // Whether edges, triangles and tetrahedra carry labels; the label table
   // (the distinct labels) follows the attribute table.
   bool labelled = false;
-  // Whether one-vertex splits and cell counts are predicted from the
-  // decoded neighbourhood of their vertex (the default) or from the cell
-  // statistics of their level alone (EncodeOptions::fastDecode).
-  bool neighbourhoodPredictions = true;
+  // Coded for fast decoding (EncodeOptions::fastDecode).
+  bool fastDecode = false;
 
   // Float32 mode with float64 residuals (bits 64): the kd-tree codes each
   // coordinate's float32 rounding, and two hidden attributes at the end of
@@ -248,12 +246,13 @@ struct EncodeOptions {
   // growing by a quarter each up to this size) so that a viewer can show
   // something early and refine it often.
   size_t chunkBytes = 16 * 1024;
-  // Predict one-vertex splits and cell counts from the statistics of their
-  // kd-tree level alone instead of from the decoded neighbourhood: the
-  // decoder skips the neighbourhood walk and the mixing of every such
-  // decision, the larger share of its work on meshes, at the price of a
-  // larger stream (docs/BENCHMARKS.md has both). Point clouds, which have
-  // no neighbourhood, code the same either way.
+  // Predict where a vertex lies from its neighbours' positions along the
+  // split axis alone, read in one pass over its edges, and code the counts
+  // of cells of several vertices without its neighbourhood: the decoder
+  // skips the full neighbourhood walks (star sums, planes, parallelograms)
+  // and the mixing of each such decision, the larger share of its work on
+  // meshes, for a larger stream (docs/BENCHMARKS.md has both). Point
+  // clouds, which have no neighbourhood, code the same either way.
   bool fastDecode = false;
   // Called now and then during long encodes; may be empty.
   std::function<void(const EncodeProgress&)> progress;
