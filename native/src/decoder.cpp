@@ -76,9 +76,6 @@ struct Decoder::State {
   // Connectivity: the complex on the current cells. Levels past the last
   // geometric one split cells of coincident vertices in halves.
   bool connectivity = false;
-  // Cell counts predicted from the neighbourhood (streams with
-  // connectivity, unless coded for fast decoding).
-  bool predictions = false;
   // Vertices have ids (and coincident ones their own levels) in streams
   // with connectivity or attributes.
   bool named = false;
@@ -137,11 +134,10 @@ struct Decoder::State {
     schedule.emplace(header);
     dequantizer.emplace(header);
     connectivity = header.maxDimension > 0;
-    predictions = connectivity && !header.fastDecode;
     named = connectivity || header.attributeCount > 0;
     attributeTableRead = header.attributeCount == 0;
     labelTableRead = !header.labelled;
-    counts.emplace(schedule->levels, predictions);
+    counts.emplace(schedule->levels, connectivity);
     coder.setMeasuring(options.measureCost);
     const Cell root{{0, 0, 0}, header.vertexCount, 0, 0, 0};
     (header.vertexCount == 1 ? singles : cells).push_back(root);
@@ -229,7 +225,7 @@ struct Decoder::State {
     const bool geometric = level < schedule->levels;
     const uint32_t firstHalf =
         geometric ? counts->code(coder, population, level, cell.parentOneSided, 0,
-                                 predictions ? predictor->countContext(cell.vertex, level, cell.parentOneSided)
+                                 connectivity ? predictor->countContext(cell.vertex, level, cell.parentOneSided)
                                               : CountContext{})
                   : population / 2;
     const bool oneSided = firstHalf == 0 || firstHalf == population;

@@ -363,8 +363,7 @@ EncodeResult encodeStream(const Complex& complex, const EncodeOptions& options, 
   ChunkWriter chunks(body, options.chunkBytes);
   RangeEncoder& coder = chunks.coder();
   header.fastDecode = options.fastDecode;
-  const bool predictions = connectivity && !header.fastDecode;  // cell counts from the neighbourhood
-  CountCoder counts(schedule.levels, predictions);
+  CountCoder counts(schedule.levels, connectivity);
   SimplexStore forward;
   forward.reset(header.vertexCount, false);
   PositionPredictor predictor(schedule, forward, header.fastDecode);
@@ -388,7 +387,6 @@ EncodeResult encodeStream(const Complex& complex, const EncodeOptions& options, 
     size_t& splitIndex;
     double& connectivityBits;
     bool connectivity;
-    bool predictions;  // cell counts from the neighbourhood
     std::function<void(const char*, double)> report;
     std::vector<LevelCost>& levels;
     const std::vector<VertexAttribute>& attributes;
@@ -409,7 +407,7 @@ EncodeResult encodeStream(const Complex& complex, const EncodeOptions& options, 
       }
       if (geometric)
         counts.code(coder, population, level, parentOneSided, firstHalf,
-                    predictions ? predictor.countContext(kept, level, parentOneSided) : CountContext{});
+                    connectivity ? predictor.countContext(kept, level, parentOneSided) : CountContext{});
       if (connectivity && added != kNoSimplex) {
         const double before = coder.cost();
         splitter.split(coder, kept, added, level, splitBalance(population, firstHalf, geometric),
@@ -461,7 +459,7 @@ EncodeResult encodeStream(const Complex& complex, const EncodeOptions& options, 
     }
   } coding{header,      schedule,          counts,     coder,       chunks,     splitter,
            forward,     predictor,         records,    splitIndex,  connectivityBits, connectivity,
-           predictions,            report,      result.cost.levels, complex.attributes, held, order.vertices, attributeCoder,
+           report,      result.cost.levels, complex.attributes, held, order.vertices, attributeCoder,
            result.cost.attributeBits, inputOfId};
   traverseKdTree(order.keys, schedule, connectivity || named, coding);
   if (afterGeometry) {

@@ -502,14 +502,13 @@ bool PositionPredictor::contextsOf(uint32_t vertex, int level, SingleContexts& c
   return true;
 }
 
-bool PositionPredictor::alongAxisContext(uint32_t vertex, int level, int& context, bool& mirrored) {
-  static_assert(kAlongAxisModels == kFamilySize[int(ModelFamily::OneVertexAlongAxis)]);
+bool PositionPredictor::gatherAlongAxis(uint32_t vertex, int level, Neighbourhood& around, double& centroid) {
   if (vertex >= store_.vertexCapacity() || vertex >= places_.size()) return false;
   const int axis = axis_[size_t(level)];
   const double inverseHalfWidth = inverseHalfWidths_[size_t(level)];
   const double atAxis = places_[vertex].centre[axis];
   const Place* places = places_.data();
-  Neighbourhood around{};
+  around.alongAxis = {};
   double sum = 0;  // of the neighbours' offsets along the axis, in half widths
   uint32_t count = 0;
   store_.forEachIncident(1, vertex, [&](uint32_t edge, uint32_t position) {
@@ -519,16 +518,37 @@ bool PositionPredictor::alongAxisContext(uint32_t vertex, int level, int& contex
     ++count;
   });
   if (count == 0) return false;
+  centroid = sum / double(count);
+  return true;
+}
+
+bool PositionPredictor::alongAxisContext(uint32_t vertex, int level, int& context, bool& mirrored) {
+  static_assert(kAlongAxisModels == kFamilySize[int(ModelFamily::OneVertexAlongAxis)]);
+  Neighbourhood around;
+  double centroid = 0;
+  if (!gatherAlongAxis(vertex, level, around, centroid)) return false;
   ++positionPredictions_;
-  mirrored = sum < 0;
-  const double centroid = std::fabs(sum) / double(count);
-  const int bucket = centroid < 0.25 ? 0 : centroid < 0.75 ? 1 : centroid < 1.5 ? 2 : 3;
+  mirrored = centroid < 0;
+  const double offset = std::fabs(centroid);
+  const int bucket = offset < 0.25 ? 0 : offset < 0.75 ? 1 : offset < 1.5 ? 2 : 3;
   context = refinementClass(around, mirrored, false) * kAlongAxisCentroidBuckets + bucket;
   return true;
 }
 
 CountContext PositionPredictor::countContext(uint32_t vertex, int level, bool parentOneSided) {
   Neighbourhood around;
+  if (fastDecode_) {
+    // The class by where the centroid lies, as for a vertex in no triangle.
+    double centroid = 0;
+    if (!gatherAlongAxis(vertex, level, around, centroid)) return {};
+    ++countPredictions_;
+    CountContext context;
+    context.mirrored = centroid < 0;
+    const double offset = std::fabs(centroid);
+    context.neighbourhoodClass = offset < 0.5 ? 10 : offset < 1.5 ? 11 : 12;
+    context.refinement = refinementClass(around, context.mirrored, false);
+    return context;
+  }
   if (!(parentOneSided ? gather<true>(vertex, level, around) : gather<false>(vertex, level, around))) return {};
   ++countPredictions_;
   const Features f = features(around, level);

@@ -53,10 +53,11 @@
 // classes for CountCoder.
 //
 // A stream coded for fast decoding (EncodeOptions::fastDecode) keeps only
-// what one pass over the vertex's edges gives: each one-vertex split is
-// coded with one model chosen by the refinement class and where the
-// neighbours' centroid lies along the split axis, mirrored by the
-// centroid's side; cells of several vertices get no class.
+// what one pass over the vertex's edges gives: where the neighbours lie
+// along the split axis (the refinement class) and where their centroid
+// lies, mirrored by the centroid's side. A one-vertex split is coded with
+// one model chosen by the two, a cell of several vertices with the
+// centroid's neighbourhood class and the refinement class.
 #pragma once
 
 #include <algorithm>
@@ -300,6 +301,9 @@ class PositionPredictor {
   // Fast decoding: the model of a one-vertex split from the vertex's edges,
   // and whether it is mirrored; false for a vertex in no edge.
   bool alongAxisContext(uint32_t vertex, int level, int& context, bool& mirrored);
+  // The bins of the neighbours through edges along the split axis and their
+  // centroid's offset in half widths (fast decoding).
+  bool gatherAlongAxis(uint32_t vertex, int level, Neighbourhood& around, double& centroid);
   // The refinement class without far halves, by centroid bucket.
   static constexpr int kAlongAxisCentroidBuckets = 4;
   static constexpr size_t kAlongAxisModels = size_t(CountContext::kRefinementClasses) * kAlongAxisCentroidBuckets;

@@ -246,13 +246,13 @@ struct EncodeOptions {
   // growing by a quarter each up to this size) so that a viewer can show
   // something early and refine it often.
   size_t chunkBytes = 16 * 1024;
-  // Predict where a vertex lies from its neighbours' positions along the
-  // split axis alone, read in one pass over its edges, and code the counts
-  // of cells of several vertices without its neighbourhood: the decoder
-  // skips the full neighbourhood walks (star sums, planes, parallelograms)
-  // and the mixing of each such decision, the larger share of its work on
-  // meshes, for a larger stream (docs/BENCHMARKS.md has both). Point
-  // clouds, which have no neighbourhood, code the same either way.
+  // Predict where vertices lie from their neighbours' positions along the
+  // split axis alone, read in one pass over a vertex's edges: the decoder
+  // skips the full neighbourhood walks (sums over the triangles, planes,
+  // parallelograms) and the mixing of one-vertex splits, the larger share
+  // of its work on meshes, for a larger stream (docs/BENCHMARKS.md has
+  // both). Point clouds, which have no neighbourhood, code the same either
+  // way.
   bool fastDecode = false;
   // Called now and then during long encodes; may be empty.
   std::function<void(const EncodeProgress&)> progress;
