@@ -535,20 +535,23 @@ bool PositionPredictor::alongAxisContext(uint32_t vertex, int level, int& contex
   return true;
 }
 
-CountContext PositionPredictor::countContext(uint32_t vertex, int level, bool parentOneSided) {
+// The class by where the centroid lies, as for a vertex in no triangle.
+CountContext PositionPredictor::alongAxisCountContext(uint32_t vertex, int level) {
   Neighbourhood around;
-  if (fastDecode_) {
-    // The class by where the centroid lies, as for a vertex in no triangle.
-    double centroid = 0;
-    if (!gatherAlongAxis(vertex, level, around, centroid)) return {};
-    ++countPredictions_;
-    CountContext context;
-    context.mirrored = centroid < 0;
-    const double offset = std::fabs(centroid);
-    context.neighbourhoodClass = offset < 0.5 ? 10 : offset < 1.5 ? 11 : 12;
-    context.refinement = refinementClass(around, context.mirrored, false);
-    return context;
-  }
+  double centroid = 0;
+  if (!gatherAlongAxis(vertex, level, around, centroid)) return {};
+  ++countPredictions_;
+  CountContext context;
+  context.mirrored = centroid < 0;
+  const double offset = std::fabs(centroid);
+  context.neighbourhoodClass = offset < 0.5 ? 10 : offset < 1.5 ? 11 : 12;
+  context.refinement = refinementClass(around, context.mirrored, false);
+  return context;
+}
+
+CountContext PositionPredictor::countContext(uint32_t vertex, int level, bool parentOneSided) {
+  if (fastDecode_) return alongAxisCountContext(vertex, level);
+  Neighbourhood around;
   if (!(parentOneSided ? gather<true>(vertex, level, around) : gather<false>(vertex, level, around))) return {};
   ++countPredictions_;
   const Features f = features(around, level);

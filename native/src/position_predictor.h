@@ -141,11 +141,10 @@ class PositionPredictor {
                   bool parentOneSided, bool inFirstHalf) {
     SingleContexts c;
     bool first;
-    int alongAxis = 0;
-    if (fastDecode_ ? !alongAxisContext(vertex, level, alongAxis, c.mirrored) : !contextsOf(vertex, level, c)) {
+    if (fastDecode_) {
+      first = codeSingleAlongAxis(coder, counts, vertex, level, parentOneSided, inFirstHalf);
+    } else if (!contextsOf(vertex, level, c)) {
       first = counts.codeSingle(coder, level, parentOneSided, inFirstHalf);
-    } else if (fastDecode_) {
-      first = coder.bit(alongAxisModels_[size_t(alongAxis)], inFirstHalf != c.mirrored) != c.mirrored;
     } else {
       const bool bit = codeWithMixers(
           coder, std::array<Mixer<kSingleInputs>*, 3>{&mixer_, &parallelogramMixer_, &planeAndCentroidMixer_},
@@ -161,6 +160,19 @@ class PositionPredictor {
     const double quarter = widths_[size_t(level)][size_t(axis)] * 0.25;
     places_[vertex].centre[axis] += first ? -quarter : quarter;
     return first;
+  }
+
+  // codeSingle() of a stream coded for fast decoding, without moving the
+  // cell. Out of line: inlined, it made the loop of the default coding
+  // slower.
+  template <class Coder>
+  [[gnu::noinline]] bool codeSingleAlongAxis(Coder& coder, CountCoder& counts, uint32_t vertex, int level,
+                                             bool parentOneSided, bool inFirstHalf) {
+    int context = 0;
+    bool mirrored = false;
+    if (!alongAxisContext(vertex, level, context, mirrored))
+      return counts.codeSingle(coder, level, parentOneSided, inFirstHalf);
+    return coder.bit(alongAxisModels_[size_t(context)], inFirstHalf != mirrored) != mirrored;
   }
 
   // A split left `isolated` in no simplex and its cell's other half, the
@@ -257,7 +269,8 @@ class PositionPredictor {
     bool hasPlane = false, hasParallelogram = false, mirrored = false;
     bool outsideUp = false;  // an oriented normal points to the upper half
   };
-  Features features(const Neighbourhood& around, int level) const;
+  // Inlined always: its two callers use different parts of it.
+  [[gnu::always_inline]] inline Features features(const Neighbourhood& around, int level) const;
   // Sums the neighbours of `vertex` against the split of `level`, with
   // the parallelogram predictions if kParallelograms; false without any.
   template <bool kParallelograms>
@@ -304,6 +317,7 @@ class PositionPredictor {
   // The bins of the neighbours through edges along the split axis and their
   // centroid's offset in half widths (fast decoding).
   bool gatherAlongAxis(uint32_t vertex, int level, Neighbourhood& around, double& centroid);
+  CountContext alongAxisCountContext(uint32_t vertex, int level);
   // The refinement class without far halves, by centroid bucket.
   static constexpr int kAlongAxisCentroidBuckets = 4;
   static constexpr size_t kAlongAxisModels = size_t(CountContext::kRefinementClasses) * kAlongAxisCentroidBuckets;
