@@ -126,8 +126,8 @@ int main(int argc, char** argv) {
       operators += line;
     }
   }
-  std::printf("\nEncoded with --fast-decode (no neighbourhood predictions), against the default stream and Draco "
-              "-cl 10 above:\n\n| model | bits | conn / geom / total bpv | size vs default | size vs Draco -cl 10 | "
+  std::printf("\nEncoded with --fast-decode (predictions along the split axis alone), against the default stream and "
+              "Draco -cl 10 above:\n\n| model | bits | conn / geom / total bpv | size vs default | size vs Draco -cl 10 | "
               "encode Mtri/s | decode Mtri/s | encode time ratio vs Draco | decode time ratio vs Draco | decode "
               "speed-up vs default |\n");
   std::printf("|---|---:|---|---:|---:|---:|---:|---:|---:|---:|\n%s", fast.c_str());
