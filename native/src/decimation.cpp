@@ -56,6 +56,22 @@ void layOutInSplitOrder(const std::vector<T>& reversed, const std::vector<uint64
 
 namespace {
 
+// A counting sort: calls place(i, slot) for each item i in 0..count-1
+// whose key(i) is below `keys` (others are left out), slots numbered in the
+// order of keys, items of one key in their own order. Returns where each
+// key's items start, then their end (keys + 1 values).
+template <class Key, class Place>
+std::vector<uint32_t> countingSort(size_t count, size_t keys, Key&& key, Place&& place) {
+  std::vector<uint32_t> start(keys + 1, 0);
+  for (size_t i = 0; i < count; ++i)
+    if (const size_t k = key(i); k < keys) ++start[k + 1];
+  for (size_t k = 0; k < keys; ++k) start[k + 1] += start[k];
+  std::vector<uint32_t> next(start.begin(), start.end() - 1);
+  for (size_t i = 0; i < count; ++i)
+    if (const size_t k = key(i); k < keys) place(i, next[k]++);
+  return start;
+}
+
 // firstWithSameVertices() for tuples of kArity vertices. Each tuple becomes
 // a record of its vertices but the least, ascending, and its index; the
 // records are placed by least vertex (a counting sort, which keeps their
@@ -68,38 +84,18 @@ LargeArray<uint32_t> firstWithSameVerticesOf(const LargeArray<uint32_t>& tuples,
   using Record = std::array<uint32_t, kArity>;  // [kArity - 1]: the tuple's index
   const size_t count = tuples.size() / kArity;
   if (count == 0) return {};
-  // The vertices ascending, by a network of minima and maxima.
-  auto sorted = [&tuples](size_t i) {
-    std::array<uint32_t, kArity> v;
-    std::copy_n(tuples.begin() + std::ptrdiff_t(i * kArity), kArity, v.begin());
-    auto order = [&v](size_t a, size_t b) {
-      const uint32_t low = std::min(v[a], v[b]);
-      v[b] = std::max(v[a], v[b]);
-      v[a] = low;
-    };
-    if constexpr (kArity == 2) {
-      order(0, 1);
-    } else if constexpr (kArity == 3) {
-      order(0, 1), order(1, 2), order(0, 1);
-    } else {
-      order(0, 1), order(2, 3), order(0, 2), order(1, 3), order(1, 2);
-    }
-    return v;
-  };
-  std::vector<uint32_t> start(size_t(vertexCount) + 1, 0);
-  for (size_t i = 0; i < count; ++i)
-    ++start[size_t(*std::min_element(&tuples[i * kArity], &tuples[i * kArity] + kArity)) + 1];
-  for (size_t v = 0; v < vertexCount; ++v) start[v + 1] += start[v];
   LargeArray<Record> records(count);
-  {
-    std::vector<uint32_t> next(start.begin(), start.end() - 1);  // where each vertex's next record goes
-    for (size_t i = 0; i < count; ++i) {
-      const std::array<uint32_t, kArity> v = sorted(i);
-      Record& record = records[next[v[0]]++];
-      std::copy_n(v.begin() + 1, kArity - 1, record.begin());
-      record[kArity - 1] = uint32_t(i);
-    }
-  }
+  const std::vector<uint32_t> start = countingSort(
+      count, vertexCount,
+      [&tuples](size_t i) { return size_t(*std::min_element(&tuples[i * kArity], &tuples[i * kArity] + kArity)); },
+      [&](size_t i, uint32_t slot) {
+        std::array<uint32_t, kArity> v;
+        std::copy_n(tuples.begin() + std::ptrdiff_t(i * kArity), kArity, v.begin());
+        sortFewVertices(v.data(), int(kArity));
+        Record& record = records[slot];
+        std::copy_n(v.begin() + 1, kArity - 1, record.begin());
+        record[kArity - 1] = uint32_t(i);
+      });
   LargeArray<uint32_t> first(count);
   auto sameSet = [](const Record& a, const Record& b) { return std::equal(a.begin(), a.end() - 1, b.begin()); };
   for (size_t v = 0; v < vertexCount; ++v) {
@@ -201,13 +197,12 @@ Status buildInputComplex(const Complex& complex, const std::vector<uint32_t>& id
       for (size_t i = 1; i < arity; ++i) least = std::min(least, kdRank[mine.tuples[c * arity + i]]);
       return least;
     };
-    std::vector<uint32_t> start(n + 1, 0);
-    for (size_t c = 0; c < first.size(); ++c)
-      if (first[c] == c) ++start[size_t(leastRank(c)) + 1];
-    for (size_t r = 0; r < n; ++r) start[r + 1] += start[r];
-    LargeArray<uint32_t> addOrder(start[n]);
-    for (size_t c = 0; c < first.size(); ++c)
-      if (first[c] == c) addOrder[start[leastRank(c)]++] = uint32_t(c);
+    size_t kept = 0;
+    for (size_t c = 0; c < first.size(); ++c) kept += first[c] == c;
+    LargeArray<uint32_t> addOrder(kept);
+    countingSort(
+        first.size(), n, [&](size_t c) { return first[c] == c ? size_t(leastRank(c)) : n; },
+        [&](size_t c, uint32_t slot) { addOrder[slot] = uint32_t(c); });
     // The pool at its final size at once, not grown by doubling.
     store.setCapacity(d, kNoSimplex, uint32_t(addOrder.size()));
     for (const uint32_t c : addOrder) {

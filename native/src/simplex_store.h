@@ -10,6 +10,7 @@
 // other vertices; walks drop them as they pass.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <cstddef>
 #include <cstdint>
@@ -33,6 +34,24 @@ inline int tupleParity(const uint32_t* v, int n) {
   for (int i = 0; i < n; ++i)
     for (int j = i + 1; j < n; ++j) inversions += v[i] > v[j];
   return inversions & 1;
+}
+
+// Sorts the n ≤ 4 vertex ids v[0..n) ascending by a network of minima and
+// maxima: no branch on the ids, whose order is a coin toss for the branch
+// predictor.
+inline void sortFewVertices(uint32_t* v, int n) {
+  auto order = [v](int a, int b) {
+    const uint32_t low = std::min(v[a], v[b]);
+    v[b] = std::max(v[a], v[b]);
+    v[a] = low;
+  };
+  if (n == 2) {
+    order(0, 1);
+  } else if (n == 3) {
+    order(0, 1), order(1, 2), order(0, 1);
+  } else if (n == 4) {
+    order(0, 1), order(2, 3), order(0, 2), order(1, 3), order(1, 2);
+  }
 }
 
 class SimplexStore {

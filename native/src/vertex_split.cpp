@@ -88,17 +88,7 @@ void gatherStar(SimplexStore& store, uint32_t v, std::vector<StarEntry>& star,
       int n = 0;
       for (int i = 0; i <= d; ++i)
         if (i != int(position)) entry.others[n++] = vertices[i];
-      // At most three: a sorting network of minima and maxima.
-      auto order = [&entry](int i, int j) {
-        const uint32_t low = std::min(entry.others[i], entry.others[j]);
-        entry.others[j] = std::max(entry.others[i], entry.others[j]);
-        entry.others[i] = low;
-      };
-      if (n >= 2) order(0, 1);
-      if (n == 3) {
-        order(1, 2);
-        order(0, 1);
-      }
+      sortFewVertices(entry.others, n);
       star.push_back(entry);
     });
     sortByOthers(star, begin[size_t(d)], star.size(), d);
