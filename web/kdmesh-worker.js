@@ -99,20 +99,26 @@ function vertexNormals(positions, triangles) {
   const normals = new Float32Array(positions.buffer.byteLength / 4).subarray(0, positions.length);
   for (let t = 0; t < triangles.length; t += 3) {
     const a = 3 * triangles[t], b = 3 * triangles[t + 1], c = 3 * triangles[t + 2];
-    const ux = positions[b] - positions[a], uy = positions[b + 1] - positions[a + 1], uz = positions[b + 2] - positions[a + 2];
-    const vx = positions[c] - positions[a], vy = positions[c + 1] - positions[a + 1], vz = positions[c + 2] - positions[a + 2];
+    const ax = positions[a], ay = positions[a + 1], az = positions[a + 2];
+    const ux = positions[b] - ax, uy = positions[b + 1] - ay, uz = positions[b + 2] - az;
+    const vx = positions[c] - ax, vy = positions[c + 1] - ay, vz = positions[c + 2] - az;
     const nx = uy * vz - uz * vy, ny = uz * vx - ux * vz, nz = ux * vy - uy * vx;
-    for (const i of [a, b, c]) {
-      normals[i] += nx;
-      normals[i + 1] += ny;
-      normals[i + 2] += nz;
-    }
+    normals[a] += nx;
+    normals[a + 1] += ny;
+    normals[a + 2] += nz;
+    normals[b] += nx;
+    normals[b + 1] += ny;
+    normals[b + 2] += nz;
+    normals[c] += nx;
+    normals[c + 1] += ny;
+    normals[c + 2] += nz;
   }
   for (let i = 0; i < positions.length; i += 3) {
-    const length = Math.hypot(normals[i], normals[i + 1], normals[i + 2]) || 1;
-    normals[i] /= length;
-    normals[i + 1] /= length;
-    normals[i + 2] /= length;
+    const x = normals[i], y = normals[i + 1], z = normals[i + 2];
+    const inverse = 1 / (Math.sqrt(x * x + y * y + z * z) || 1);
+    normals[i] = x * inverse;
+    normals[i + 1] = y * inverse;
+    normals[i + 2] = z * inverse;
   }
   return normals;
 }
@@ -142,14 +148,17 @@ function pack(Type, lists, capacity) {
 
 // Smallest and largest coordinates, [x, y, z, x, y, z].
 function bounds(positions) {
-  const box = [Infinity, Infinity, Infinity, -Infinity, -Infinity, -Infinity];
+  let minX = Infinity, minY = Infinity, minZ = Infinity, maxX = -Infinity, maxY = -Infinity, maxZ = -Infinity;
   for (let i = 0; i < positions.length; i += 3) {
-    for (let a = 0; a < 3; ++a) {
-      box[a] = Math.min(box[a], positions[i + a]);
-      box[a + 3] = Math.max(box[a + 3], positions[i + a]);
-    }
+    const x = positions[i], y = positions[i + 1], z = positions[i + 2];
+    if (x < minX) minX = x;
+    if (x > maxX) maxX = x;
+    if (y < minY) minY = y;
+    if (y > maxY) maxY = y;
+    if (z < minZ) minZ = z;
+    if (z > maxZ) maxZ = z;
   }
-  return box;
+  return [minX, minY, minZ, maxX, maxY, maxZ];
 }
 
 // Every edge of the tetrahedra once, for the wireframe view.
