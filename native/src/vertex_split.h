@@ -209,9 +209,16 @@ class VertexSplitter {
   }
   int runClass(const Entry& edge, int cutEdges, bool mirrored);
   int vertexClass(int balance) const;
+  // Decides the orientation of `simplex`, made by the split from the star
+  // entry `from`: its copy (code 3 or 4) or the simplex one dimension up
+  // that its code 4 added.
   template <class Coder>
-  void decideOrientation(Coder& coder, int dimension, uint32_t simplex, bool isCopy, uint8_t target);
-  int predictFlip(int dimension, uint32_t simplex, int& voteClass);
+  void decideOrientation(Coder& coder, int dimension, uint32_t simplex, const Entry& from, bool isCopy,
+                         uint8_t target);
+  int predictFlip(int dimension, uint32_t simplex, const Entry& from, bool isCopy, int& voteClass);
+  // The triangles after the split that can share an edge with the new
+  // triangle `simplex` made from `from` (predictFlip()).
+  const std::vector<uint32_t>& triangleNeighbours(uint32_t simplex, const Entry& from, bool isCopy);
   template <int kArity>
   int voteOnFlip(uint32_t simplex, const std::vector<uint32_t>& candidates, int& voteClass);
 
@@ -234,6 +241,7 @@ class VertexSplitter {
   // first orientation decision of that dimension (most splits of a surface
   // need none of dimension 3).
   std::array<std::vector<uint32_t>, 4> around_;
+  std::vector<uint32_t> neighbours_;  // triangleNeighbours()
   std::array<bool, 4> aroundReady_{};
   const std::vector<uint32_t>& around(int dimension);
   // Per dimension, for stars of more than kIndexedStar simplices around: the
@@ -325,10 +333,10 @@ uint8_t VertexSplitter::binarise(uint8_t possible, uint8_t code, CodeBit&& codeB
 }
 
 template <class Coder>
-void VertexSplitter::decideOrientation(Coder& coder, int dimension, uint32_t simplex, bool isCopy,
-                                       uint8_t target) {
+void VertexSplitter::decideOrientation(Coder& coder, int dimension, uint32_t simplex, const Entry& from,
+                                       bool isCopy, uint8_t target) {
   int voteClass = 0;
-  const int predicted = predictFlip(dimension, simplex, voteClass);
+  const int predicted = predictFlip(dimension, simplex, from, isCopy, voteClass);
   const int faceOfHigher = isFaceOfHigher(dimension, simplex);
   int flip = predicted;
   if (target != split_record::kFree)
@@ -479,14 +487,18 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int
     }
   }
 
+  // around() builds each dimension's lists and facet index again when first
+  // asked; a vote that does not ask (triangleNeighbours()) must not find
+  // the index of an earlier split.
   aroundReady_.fill(false);
+  for (std::vector<FacetEntry>& facets : facets_) facets.clear();
   for (const Entry& entry : star_) {
     const int d = entry.dimension;
     if (entry.copy != kNoSimplex && d >= 2)
-      decideOrientation(coder, d, entry.copy, true,
+      decideOrientation(coder, d, entry.copy, entry, true,
                         uint8_t((entry.record >> split_record::kCopyTargetShift) & 3));
     if (entry.added != kNoSimplex && d + 1 >= 2)
-      decideOrientation(coder, d + 1, entry.added, false,
+      decideOrientation(coder, d + 1, entry.added, entry, false,
                         uint8_t((entry.record >> split_record::kNewTargetShift) & 3));
   }
   if (labels_) {
