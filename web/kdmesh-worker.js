@@ -146,7 +146,8 @@ function pack(Type, lists, capacity) {
   });
 }
 
-// Smallest and largest coordinates, [x, y, z, x, y, z].
+// Smallest and largest coordinates, [x, y, z, x, y, z]; NaN coordinates
+// are passed over.
 function bounds(positions) {
   let minX = Infinity, minY = Infinity, minZ = Infinity, maxX = -Infinity, maxY = -Infinity, maxZ = -Infinity;
   for (let i = 0; i < positions.length; i += 3) {

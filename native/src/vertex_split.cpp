@@ -640,9 +640,10 @@ int VertexSplitter::voteOnFlip(uint32_t simplex, const std::vector<uint32_t>& ca
 // copies; the copy of a triangle v a b (it is v2 a b) shares a b with the
 // triangle itself, and v2 a or v2 b only with star triangles through the
 // edge v a or v b, their copies and the triangles that those edges added.
-// The vote over these few counts the same neighbours as one over all.
-const std::vector<uint32_t>& VertexSplitter::triangleNeighbours(uint32_t simplex, const Entry& from,
-                                                                bool isCopy) {
+// The vote over these few counts the same neighbours as one over all
+// (voteOnFlip() skips the triangle itself). A triangle's links are set
+// here: possibleCodes() refused the split otherwise.
+const std::vector<uint32_t>& VertexSplitter::triangleNeighbours(const Entry& from, bool isCopy) {
   neighbours_.clear();
   const uint32_t edgeA = isCopy ? from.links[0] : uint32_t(&from - star_.data());
   const uint32_t edgeB = isCopy ? from.links[1] : edgeA;
@@ -656,10 +657,10 @@ const std::vector<uint32_t>& VertexSplitter::triangleNeighbours(uint32_t simplex
   }
   if (isCopy) {
     for (const uint32_t edge : {edgeA, edgeB})
-      if (edge != kNoSimplex && star_[edge].added != kNoSimplex) neighbours_.push_back(star_[edge].added);
+      if (star_[edge].added != kNoSimplex) neighbours_.push_back(star_[edge].added);
   } else {
     for (size_t e = begin_[1]; e < begin_[2]; ++e)
-      if (star_[e].added != kNoSimplex && star_[e].added != simplex) neighbours_.push_back(star_[e].added);
+      if (star_[e].added != kNoSimplex) neighbours_.push_back(star_[e].added);
   }
   return neighbours_;
 }
@@ -667,7 +668,7 @@ const std::vector<uint32_t>& VertexSplitter::triangleNeighbours(uint32_t simplex
 int VertexSplitter::predictFlip(int dimension, uint32_t simplex, const Entry& from, bool isCopy, int& voteClass) {
   // Stars small enough to vote without the facet index (see around()).
   if (dimension == 2 && star_.size() * 2 <= kIndexedStar) {
-    const int flip = voteOnFlip<3>(simplex, triangleNeighbours(simplex, from, isCopy), voteClass);
+    const int flip = voteOnFlip<3>(simplex, triangleNeighbours(from, isCopy), voteClass);
 #ifdef KDMESH_CHECK_VOTES
     int pollClass = 0;
     if (voteOnFlip<3>(simplex, around(2), pollClass) != flip || pollClass != voteClass) std::abort();

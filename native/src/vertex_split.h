@@ -217,8 +217,8 @@ class VertexSplitter {
                          uint8_t target);
   int predictFlip(int dimension, uint32_t simplex, const Entry& from, bool isCopy, int& voteClass);
   // The triangles after the split that can share an edge with the new
-  // triangle `simplex` made from `from` (predictFlip()).
-  const std::vector<uint32_t>& triangleNeighbours(uint32_t simplex, const Entry& from, bool isCopy);
+  // triangle made from `from` (predictFlip()).
+  const std::vector<uint32_t>& triangleNeighbours(const Entry& from, bool isCopy);
   template <int kArity>
   int voteOnFlip(uint32_t simplex, const std::vector<uint32_t>& candidates, int& voteClass);
 
