@@ -2,7 +2,8 @@
 # Regenerates the decoder fuzzer's seed streams, tests/fuzz/seeds/decoder/,
 # by encoding the reader seeds (tests/fuzz/seeds/) with build/kdmesh, one
 # stream per coding path: connectivity of every dimension on a grid and in
-# float32 mode, connectivity coded for fast decoding, exact attributes, quantized and geometric octahedral
+# float32 mode, connectivity coded for fast decoding (with edge expansions
+# coded by their fan's cuts), exact attributes, quantized and geometric octahedral
 # attributes with labels, octahedral normals of a point cloud, a label table, infinite and NaN coordinates, and float64
 # coordinates with their residual attributes. Run it after a
 # format change; the test FuzzSeeds.DecoderSeedsDecodeAndCoverEveryTable
@@ -18,6 +19,7 @@ mkdir -p "$out"
 "$cli" encode "$in/mixed.obj" -o "$out/mixed.kdm" --exact -q
 "$cli" encode "$in/tetrahedra.mesh" -o "$out/tetrahedra.kdm" --bits 6 -q
 "$cli" encode "$in/mixed.obj" -o "$out/fast-decode.kdm" --bits 10 --fast-decode -q
+"$cli" encode "$in/surface.ply" -o "$out/fast-decode-surface.kdm" --bits 10 --fast-decode -q
 "$cli" encode "$in/colours.ply" -o "$out/attributes.kdm" --exact -q
 "$cli" encode "$in/regions.mesh" -o "$out/labels.kdm" --exact -q
 "$cli" encode "$in/surface.ply" -o "$out/quantized.kdm" --bits 10 --attr-bits 12 --normal-bits 8 -q

@@ -434,9 +434,9 @@ int runInfo(const std::string& input, bool json, bool perLevel) {
                 jsonNumber(8.0 * double(bytes.size()) / n).c_str(),
                 jsonNumber(cost.geometryBits / n).c_str(),
                 jsonNumber(cost.connectivityBits / n).c_str());
-    std::printf("  \"operators\": {\"vertexSplits\": %" PRIu64 ", \"edgeExpansions\": %" PRIu64 ", "
-                "\"codes\": [",
-                stats.vertexSplits, stats.edgeExpansions);
+    std::printf("  \"operators\": {\"vertexSplits\": %" PRIu64 ", \"edgeExpansions\": %" PRIu64
+                ", \"fanExpansions\": %" PRIu64 ", \"codes\": [",
+                stats.vertexSplits, stats.edgeExpansions, stats.fanExpansions);
     for (int d = 0; d < 4; ++d)
       std::printf("%s[%" PRIu64 ", %" PRIu64 ", %" PRIu64 ", %" PRIu64 "]", d ? ", " : "", stats.codes[d][0],
                   stats.codes[d][1], stats.codes[d][2], stats.codes[d][3]);
@@ -509,6 +509,8 @@ int runInfo(const std::string& input, bool json, bool perLevel) {
                 stats.vertexSplits, n > 1 ? 100.0 * double(stats.vertexSplits) / (n - 1) : 0.0,
                 h.vertexCount - 1, stats.edgeExpansions,
                 stats.vertexSplits ? 100.0 * double(stats.edgeExpansions) / double(stats.vertexSplits) : 0.0);
+    if (stats.fanExpansions > 0)
+      std::printf("                %" PRIu64 " edge expansions coded by their fan's two cuts\n", stats.fanExpansions);
     static const char* const kNames[4] = {"vertex", "edge", "triangle", "tetrahedron"};
     for (int d = 0; d < 4; ++d) {
       const auto& c = stats.codes[size_t(d)];

@@ -12,7 +12,7 @@
 
 namespace kdmesh {
 
-constexpr uint16_t kFormatVersion = 25;
+constexpr uint16_t kFormatVersion = 26;
 
 // What a read of bytes that may not all have arrived found.
 enum class Parsed { Complete, Incomplete, Malformed };

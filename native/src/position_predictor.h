@@ -190,6 +190,8 @@ class PositionPredictor {
   void forgetAcross(uint32_t triangle, uint32_t position);
 
   bool geometric(int level) const { return size_t(level) < axis_.size(); }
+  // Whether the stream is coded for fast decoding.
+  bool fastDecode() const { return fastDecode_; }
   double inverseHalfWidth(int level) const { return inverseHalfWidths_[size_t(level)]; }
 
   // The split axis of a geometric `level`, and the centre of a vertex's

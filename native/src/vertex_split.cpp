@@ -203,6 +203,7 @@ void VertexSplitter::classifyEdges(uint32_t v, int level) {
   }
   if (volume) return;
   meanLength /= double(last - first);
+  meanLength_ = meanLength;
   for (size_t i = first; i < last; ++i) {
     const double cosine = cosines_[i - first], magnitude = std::fabs(cosine);
     // Between a fan neighbour on v's side and one on v2's side lies a cut
@@ -382,6 +383,48 @@ void VertexSplitter::indexFan() {
     at = next;
   } while (at != first && fanOrder_.size() <= last - first);
   if (at == first && fanOrder_.size() == last - first) fanSize_ = int(fanOrder_.size());
+}
+
+int VertexSplitter::fanSlot(const Entry& triangle) const {
+  const int a = star_[triangle.links[0]].fanIndex, b = star_[triangle.links[1]].fanIndex;
+  return (a + 1) % fanSize_ == b ? a : b;
+}
+
+// The star is one closed fan (closedFanStar()): its records make an edge
+// expansion when the vertex is coded 4 and exactly two edges are, the other
+// edges are coded 1 or 2, alike along each arc between the two and
+// different on the two arcs, and each triangle goes where its arc's edges
+// go (an arc without edges: where the other arc's do not).
+bool VertexSplitter::recordsFormFanExpansion() const {
+  auto code = [](const Entry& entry) { return (entry.record & split_record::kCodeMask) + 1; };
+  if (code(star_[0]) != 4) return false;
+  const int n = fanSize_;
+  int cuts[2], found = 0;
+  for (int k = 0; k < n; ++k) {
+    const int c = code(star_[fanOrder_[size_t(k)]]);
+    if (c == 3) return false;
+    if (c != 4) continue;
+    if (found == 2) return false;
+    cuts[found++] = k;
+  }
+  if (found != 2) return false;
+  // sides[0]: the arc from the first cut to the second, sides[1]: the other.
+  int sides[2] = {0, 0};
+  for (int k = 0; k < n; ++k) {
+    if (k == cuts[0] || k == cuts[1]) continue;
+    const int c = code(star_[fanOrder_[size_t(k)]]);
+    int& side = sides[k > cuts[0] && k < cuts[1] ? 0 : 1];
+    if (side != 0 && side != c) return false;
+    side = c;
+  }
+  if (sides[0] == 0) sides[0] = 3 - sides[1];
+  if (sides[1] == 0) sides[1] = 3 - sides[0];
+  if (sides[0] + sides[1] != 3) return false;
+  for (size_t t = begin_[2]; t < begin_[3]; ++t) {
+    const int slot = fanSlot(star_[t]);
+    if (code(star_[t]) != sides[slot >= cuts[0] && slot < cuts[1] ? 0 : 1]) return false;
+  }
+  return true;
 }
 
 namespace {

@@ -26,6 +26,12 @@
 // cycle: each has two triangles coded 4, which makes the triangles between
 // cut edges cheap when the most constrained of them are taken first.
 //
+// In a stream coded for fast decoding, a star that is one closed fan of
+// triangles first gets one bit: whether the split is an edge expansion of
+// the fan (two edges coded 4, the fan's arcs between them coded 1 and 2).
+// If so, its codes follow from where the two cuts lie, coded by a walk
+// around the fan (codeFanExpansion()) instead of one code per simplex.
+//
 // Triangles and tetrahedra are oriented. A child that inherits its parent's
 // tuple keeps the parent's orientation; the second copy of a code-3 simplex
 // and the new simplex of a code 4 get one coded bit each, predicted from
@@ -112,7 +118,7 @@ class VertexSplitter {
   // predicts where v's edges go. A split tells `geometry` which triangles
   // it changed (PositionPredictor::forgetAcross).
   VertexSplitter(SimplexStore& store, PositionPredictor& geometry)
-      : store_(store), geometry_(geometry) {
+      : store_(store), geometry_(geometry), fanExpansions_(geometry.fastDecode()) {
     static_assert(sizeof(edgeModels_) / sizeof(BitModel) == kFamilySize[int(ModelFamily::EdgeCodes)]);
     static_assert(sizeof(edgeDirectionModels_) / sizeof(BitModel) ==
                   kFamilySize[int(ModelFamily::EdgeCodesByDirection)]);
@@ -208,6 +214,24 @@ class VertexSplitter {
     });
   }
   int runClass(const Entry& edge, int cutEdges, bool mirrored);
+  // Codes every entry of the star one by one, in the order of orderCodes();
+  // false when the codes contradict each other.
+  template <class Coder>
+  bool codeEntries(Coder& coder, bool geometric, int balance, int& cutEdges, bool& codedThree);
+  // Whether the star is one closed fan of triangles and nothing more.
+  bool closedFanStar() const {
+    return fanSize_ > 0 && begin_[4] == begin_[3] && begin_[3] - begin_[2] == size_t(fanSize_);
+  }
+  // Encoder: whether the records of such a star make an edge expansion
+  // that codeFanExpansion() can code.
+  bool recordsFormFanExpansion() const;
+  // The fan position of the triangle between the edges at fan positions k
+  // and k + 1 (mod fanSize_).
+  int fanSlot(const Entry& triangle) const;
+  // Codes the two cuts of a closed fan's edge expansion by a walk around
+  // the fan from its steepest edge, and gives every entry its code.
+  template <class Coder>
+  void codeFanExpansion(Coder& coder);
   int vertexClass(int balance) const;
   // Decides the orientation of `simplex`, made by the split from the star
   // entry `from`: its copy (code 3 or 4) or the simplex one dimension up
@@ -313,6 +337,23 @@ class VertexSplitter {
   std::vector<uint32_t> fanOrder_;
   int firstCut_ = -1;     // fan position of the first edge coded 4
   double halfWidth_ = 0;  // of the split cell along the split axis (0: not geometric)
+  double meanLength_ = 0;  // of the star's edges (classifyEdges(), surface stars)
+  // Fan expansions (streams coded for fast decoding): whether the closed
+  // fan's split is one, by fan size (3..9 and more) and splitBalance().
+  const bool fanExpansions_;
+  BitModel fanExpansionModels_[7][kBalanceClasses];
+  // The walk's first edge: whether it is a cut, by its direction bucket;
+  // else whether its side is not the one its direction says; when it is
+  // cut, whether the arc after it is not on the side of the next edge.
+  BitModel startCutModels_[4], startSideModels_[4], arcSideModel_;
+  // Whether an edge of the walk is a cut, by: cuts so far (0, 1); whether
+  // its direction and the next edge's agree with the current arc's side;
+  // whether it is the closer of the two to the split plane; the direction
+  // buckets of both; whether it is longer than the star's mean; how far it
+  // lies from the first cut (runClass()'s bands); edges left (1, 2, 3+).
+  static constexpr int kFanCutClasses = 2 * 2 * 2 * 2 * 4 * 4 * 2 * kCutBands * 4;
+  BitModel fanCutModels_[kFanCutClasses];
+  std::vector<uint8_t> fanLabels_, slotSides_;  // per fan position: edge code, triangle side
   // Orientation models: [dimension - 2][copy or new][vote class][face of higher].
   BitModel orientationModels_[2][2][3][2];
   std::optional<LabelCoder> labels_;
@@ -352,19 +393,8 @@ void VertexSplitter::decideOrientation(Coder& coder, int dimension, uint32_t sim
   statistics_.orientationMispredicted += mispredicted;
 }
 
-template <class Coder, class Oracle, class LabelOracle>
-bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int balance, Oracle&& oracle,
-                           LabelOracle&& labelOracle) {
-  newVertex_ = v2;
-  gatherStar(store_, v, star_, begin_);
-  linkFans();
-  classifyEdges(v, level);
-  const bool geometric = geometry_.geometric(level);
-  ++statistics_.vertexSplits;
-  int cutEdges = 0;  // edges coded 4 so far: an edge expansion has two
-  bool codedThree = false;
-  // The encoder's records come in canonical order.
-  for (Entry& entry : star_) entry.record = oracle();
+template <class Coder>
+bool VertexSplitter::codeEntries(Coder& coder, bool geometric, int balance, int& cutEdges, bool& codedThree) {
   orderCodes(geometric);
   const bool volume = begin_[4] > begin_[3];  // the star holds a tetrahedron
   size_t pairedTriangles = 0;
@@ -448,6 +478,115 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int
     codedThree |= entry.code == 3;
     ++statistics_.codes[entry.dimension][entry.code - 1];
   }
+
+  return true;
+}
+
+template <class Coder>
+void VertexSplitter::codeFanExpansion(Coder& coder) {
+  const int n = fanSize_;
+  const size_t firstEdge = begin_[1];
+  auto cosineAt = [&](int k) { return cosines_[fanOrder_[size_t(k)] - firstEdge]; };
+  // The side an edge's direction points to: 2 for v2's half.
+  auto sideAt = [&](int k) { return uint8_t(cosineAt(k) > 0 ? 2 : 1); };
+  // The encoder's code of the edge at fan position k (ignored by the decoder).
+  auto recorded = [&](int k) { return uint8_t((star_[fanOrder_[size_t(k)]].record & split_record::kCodeMask) + 1); };
+  static constexpr double kBounds[3] = {0.2, 0.45, 0.7};
+  auto bucketAt = [&](int k) { return countAtMost(std::fabs(cosineAt(k)), kBounds); };
+  // The walk starts at the steepest edge, the surest of its side.
+  int start = 0;
+  for (int k = 1; k < n; ++k)
+    if (std::fabs(cosineAt(k)) > std::fabs(cosineAt(start))) start = k;
+  fanLabels_.resize(size_t(n));
+  slotSides_.resize(size_t(n));
+  int cuts = 0, lastCut = -1;
+  uint8_t side;  // of the arc the walk is in
+  const int next = (start + 1) % n;
+  if (coder.bit(startCutModels_[bucketAt(start)], recorded(start) == 4)) {
+    cuts = 1;
+    lastCut = start;
+    fanLabels_[size_t(start)] = 4;
+    // The arc after the cut: the next edge's side, or, when that is the
+    // other cut, the opposite of the edge after it.
+    const uint8_t arc = recorded(next) != 4 ? recorded(next) : uint8_t(3 - recorded((next + 1) % n));
+    side = uint8_t(coder.bit(arcSideModel_, arc != sideAt(next)) ? 3 - sideAt(next) : sideAt(next));
+  } else {
+    side = uint8_t(coder.bit(startSideModels_[bucketAt(start)], recorded(start) != sideAt(start)) ? 3 - sideAt(start)
+                                                                                                 : sideAt(start));
+    fanLabels_[size_t(start)] = side;
+  }
+  slotSides_[size_t(start)] = side;
+  for (int step = 1; step < n; ++step) {
+    const int k = (start + step) % n, after = (k + 1) % n;
+    const int left = n - step;  // edges left, this one included
+    bool cut = false;
+    if ((cuts == 0 && left == 2) || (cuts == 1 && left == 1)) {
+      cut = true;  // the cuts still missing must be the last edges
+    } else if (cuts < 2) {
+      int band = 0;
+      if (lastCut >= 0) {
+        const int apart = std::abs(k - lastCut);
+        const int distance = std::min(apart, n - apart), half = n / 2;
+        band = distance >= half ? 4 : distance == half - 1 ? 3 : distance == half - 2 ? 2 : 1;
+      }
+      const bool longer = lengths_[fanOrder_[size_t(k)] - firstEdge] > meanLength_;
+      int context = cuts;
+      context = context * 2 + (sideAt(k) == side);
+      context = context * 2 + (sideAt(after) == side);
+      context = context * 2 + (std::fabs(cosineAt(k)) <= std::fabs(cosineAt(after)));
+      context = context * 4 + bucketAt(k);
+      context = context * 4 + bucketAt(after);
+      context = context * 2 + longer;
+      context = context * kCutBands + band;
+      context = context * 4 + std::min(left, 3);
+      cut = coder.bit(fanCutModels_[context], recorded(k) == 4);
+    }
+    if (cut) {
+      ++cuts;
+      lastCut = k;
+      side = uint8_t(3 - side);
+    }
+    fanLabels_[size_t(k)] = cut ? 4 : side;
+    slotSides_[size_t(k)] = side;
+  }
+  star_[0].code = 4;
+  ++statistics_.codes[0][3];
+  for (int k = 0; k < n; ++k) {
+    const uint8_t code = fanLabels_[size_t(k)];
+    star_[fanOrder_[size_t(k)]].code = code;
+    ++statistics_.codes[1][code - 1];
+  }
+  for (size_t t = begin_[2]; t < begin_[3]; ++t) {
+    const uint8_t code = slotSides_[size_t(fanSlot(star_[t]))];
+    star_[t].code = code;
+    ++statistics_.codes[2][code - 1];
+  }
+  ++statistics_.fanExpansions;
+}
+
+template <class Coder, class Oracle, class LabelOracle>
+bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int balance, Oracle&& oracle,
+                           LabelOracle&& labelOracle) {
+  newVertex_ = v2;
+  gatherStar(store_, v, star_, begin_);
+  linkFans();
+  classifyEdges(v, level);
+  const bool geometric = geometry_.geometric(level);
+  ++statistics_.vertexSplits;
+  int cutEdges = 0;  // edges coded 4: an edge expansion has two
+  bool codedThree = false;
+  // The encoder's records come in canonical order.
+  for (Entry& entry : star_) entry.record = oracle();
+  bool coded = false;
+  if (fanExpansions_ && geometric && closedFanStar()) {
+    const int sizeClass = std::min(fanSize_, 9) - 3;
+    coded = coder.bit(fanExpansionModels_[sizeClass][balance], recordsFormFanExpansion());
+    if (coded) {
+      codeFanExpansion(coder);
+      cutEdges = 2;
+    }
+  }
+  if (!coded && !codeEntries(coder, geometric, balance, cutEdges, codedThree)) return false;
 
   statistics_.edgeExpansions += star_[0].code == 4 && cutEdges == 2 && !codedThree;
   if (star_[0].code == 3) {  // v and v2 not joined: is either left in no simplex?

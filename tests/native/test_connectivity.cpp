@@ -122,6 +122,9 @@ TEST(Connectivity, FastDecodeStreamsRoundTripWithAxialPredictionsAlone) {
     EXPECT_EQ(theirs.countPredictions, mine.countPredictions);
     EXPECT_EQ(theirs.refinedNeighbourPredictions, mine.refinedNeighbourPredictions);
     EXPECT_EQ(theirs.vertexSplits, mine.vertexSplits);
+    EXPECT_EQ(theirs.edgeExpansions, mine.edgeExpansions);
+    EXPECT_EQ(theirs.fanExpansions, mine.fanExpansions);
+    EXPECT_LE(mine.fanExpansions, mine.edgeExpansions);
   }
   for (uint32_t seed = 1; seed <= 40; ++seed) {
     const Complex c = randomComplex(seed, 4 + int(seed % 23), 1 + int(seed % 41));
@@ -135,7 +138,14 @@ TEST(Connectivity, FastDecodeStreamsRoundTripWithAxialPredictionsAlone) {
   EncodeOptions gridFast = grid;
   gridFast.fastDecode = true;
   const Complex torus = torusMesh(24, 40);
-  EXPECT_LT(encode(torus, grid).bytes.size(), encode(torus, gridFast).bytes.size());
+  const EncodeResult full = encode(torus, grid), axial = encode(torus, gridFast);
+  EXPECT_LT(full.bytes.size(), axial.bytes.size());
+  // The same splits either way; the fast coding codes most of the closed
+  // fans' edge expansions by their two cuts, the default coding none.
+  EXPECT_EQ(axial.statistics.codes, full.statistics.codes);
+  EXPECT_EQ(axial.statistics.edgeExpansions, full.statistics.edgeExpansions);
+  EXPECT_EQ(full.statistics.fanExpansions, 0u);
+  EXPECT_GT(axial.statistics.fanExpansions * 4, axial.statistics.edgeExpansions * 3);
   fast.chunkBytes = 64;
   expectPrefixesAreProjections(torusMesh(14, 22), fast);
   expectPrefixesAreProjections(tetrahedralBlock(3, 5), fast);

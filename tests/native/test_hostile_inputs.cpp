@@ -136,7 +136,8 @@ TEST(FuzzSeeds, DecoderSeedsDecodeAndCoverEveryTable) {
   std::sort(streams.begin(), streams.end());
   ASSERT_GE(streams.size(), 8u);
   bool grid = false, connectivity = false, exactAttribute = false, uniform = false, octahedral = false,
-       geometricOctahedral = false, labelled = false, nonFinite = false, float64 = false, fastDecode = false;
+       geometricOctahedral = false, labelled = false, nonFinite = false, float64 = false, fastDecode = false,
+       fanExpansions = false;
   for (const std::filesystem::path& path : streams) {
     SCOPED_TRACE(path.filename().string());
     std::vector<uint8_t> bytes;
@@ -150,6 +151,7 @@ TEST(FuzzSeeds, DecoderSeedsDecodeAndCoverEveryTable) {
     connectivity |= c.hasSimplices();
     labelled |= decoder.header().labelled;
     fastDecode |= c.hasSimplices() && decoder.header().fastDecode;
+    fanExpansions |= decoder.statistics().fanExpansions > 0;
     float64 |= decoder.header().float64() && !c.positions64.empty();
     for (const VertexAttribute& a : c.attributes) {
       exactAttribute |= a.quantization.kind == AttributeQuantization::Exact;
@@ -160,7 +162,7 @@ TEST(FuzzSeeds, DecoderSeedsDecodeAndCoverEveryTable) {
     nonFinite |= std::any_of(c.positions.begin(), c.positions.end(), [](float x) { return !std::isfinite(x); });
   }
   EXPECT_TRUE(grid && connectivity && exactAttribute && uniform && octahedral && geometricOctahedral && labelled &&
-              nonFinite && float64 && fastDecode);
+              nonFinite && float64 && fastDecode && fanExpansions);
 }
 
 }  // namespace

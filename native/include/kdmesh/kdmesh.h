@@ -313,6 +313,9 @@ struct ConnectivityStatistics {
   // Vertex splits shaped as an edge expansion: the new edge V1V2, exactly
   // two edges coded 4 and no simplex coded 3 (the paper's cheap operator).
   uint64_t edgeExpansions = 0;
+  // Of those, the ones of closed-fan stars coded by where the fan's two
+  // cuts lie (streams coded for fast decoding; docs/FORMAT.md).
+  uint64_t fanExpansions = 0;
   // Predictions from the current complex (docs/FORMAT.md, "Contexts"):
   uint64_t edgeCodesByDirection = 0;  // edge codes conditioned on the split direction
   uint64_t countPredictions = 0;      // several-vertex cell counts with a neighbourhood class
