@@ -147,8 +147,7 @@ uint8_t VertexSplitter::possibleCodes(const Entry& entry) const {
   return possible;
 }
 
-// The bucket of an edge's |cos| against the split axis (< 0.2, 0.45, 0.7, ≥ 0.7).
-static int directionBucket(double cosine) {
+int directionBucket(double cosine) {
   static constexpr double kBounds[3] = {0.2, 0.45, 0.7};
   return countAtMost(std::fabs(cosine), kBounds);
 }
@@ -385,6 +384,12 @@ void VertexSplitter::indexFan() {
   if (at == first && fanOrder_.size() == last - first) fanSize_ = int(fanOrder_.size());
 }
 
+int VertexSplitter::cutBand(int position, int cut) const {
+  const int apart = std::abs(position - cut);
+  const int distance = std::min(apart, fanSize_ - apart), half = fanSize_ / 2;
+  return distance >= half ? 4 : distance == half - 1 ? 3 : distance == half - 2 ? 2 : 1;
+}
+
 int VertexSplitter::fanSlot(const Entry& triangle) const {
   const int a = star_[triangle.links[0]].fanIndex, b = star_[triangle.links[1]].fanIndex;
   return (a + 1) % fanSize_ == b ? a : b;
@@ -477,12 +482,7 @@ int VertexSplitter::runClass(const Entry& edge, int cutEdges, bool mirrored) {
   const int a = endOf(-1, before);
   if (a < 0) return kUncodedFan;
   const int b = endOf(1, after);
-  int cutBand = 0;
-  if (cutEdges == 1) {
-    const int apart = std::abs(int(edge.fanIndex) - firstCut_);
-    const int distance = std::min(apart, fanSize_ - apart), half = fanSize_ / 2;
-    cutBand = distance >= half ? 4 : distance == half - 1 ? 3 : distance == half - 2 ? 2 : 1;
-  }
+  const int band = cutEdges == 1 ? cutBand(edge.fanIndex, firstCut_) : 0;
   const int low = std::min(a, b), high = std::max(a, b);
   const int ends = low == 0 ? high : low == 1 ? 2 + high : 5;  // 1-1 1-2 1-c 2-2 2-c c-c
   const int run = before + after - 1;
@@ -510,7 +510,7 @@ int VertexSplitter::runClass(const Entry& edge, int cutEdges, bool mirrored) {
     const int form = run == 1 ? 0 : run == 2 ? 1 : std::min(before, after) == 1 ? 2 : 3;
     shape = kRunBase + ends * 4 + form;
   }
-  return cutBand * kRunClasses + shape;
+  return band * kRunClasses + shape;
 }
 
 // Whether v and v2 are joined: a star that is one closed fan is that of an

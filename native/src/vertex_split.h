@@ -77,6 +77,9 @@ inline uint8_t target(int parity) { return uint8_t(kParity0 + parity); }
 // Class 0 for the splits of coincident vertices past the geometric levels.
 int splitBalance(uint32_t population, uint32_t first, bool geometric);
 
+// The bucket of an edge's |cos| against the split axis (< 0.2, 0.45, 0.7, ≥ 0.7).
+int directionBucket(double cosine);
+
 // An entry of a vertex star in canonical order: by dimension, then by the
 // ascending ids of the simplex's other vertices. Entry 0 is the vertex.
 struct StarEntry {
@@ -214,6 +217,10 @@ class VertexSplitter {
     });
   }
   int runClass(const Entry& edge, int cutEdges, bool mirrored);
+  // How far the edge at fan position `position` lies from the cut at
+  // `cut`, the shorter way round, against half the fan: 4 for half or
+  // more, 3 and 2 for one and two less, else 1.
+  int cutBand(int position, int cut) const;
   // Codes every entry of the star one by one, in the order of orderCodes();
   // false when the codes contradict each other.
   template <class Coder>
@@ -350,7 +357,7 @@ class VertexSplitter {
   // its direction and the next edge's agree with the current arc's side;
   // whether it is the closer of the two to the split plane; the direction
   // buckets of both; whether it is longer than the star's mean; how far it
-  // lies from the first cut (runClass()'s bands); edges left (1, 2, 3+).
+  // lies from the first cut (cutBand()); edges left (1, 2, 3+).
   static constexpr int kFanCutClasses = 2 * 2 * 2 * 2 * 4 * 4 * 2 * kCutBands * 4;
   BitModel fanCutModels_[kFanCutClasses];
   std::vector<uint8_t> fanLabels_, slotSides_;  // per fan position: edge code, triangle side
@@ -491,20 +498,19 @@ void VertexSplitter::codeFanExpansion(Coder& coder) {
   auto sideAt = [&](int k) { return uint8_t(cosineAt(k) > 0 ? 2 : 1); };
   // The encoder's code of the edge at fan position k (ignored by the decoder).
   auto recorded = [&](int k) { return uint8_t((star_[fanOrder_[size_t(k)]].record & split_record::kCodeMask) + 1); };
-  static constexpr double kBounds[3] = {0.2, 0.45, 0.7};
-  auto bucketAt = [&](int k) { return countAtMost(std::fabs(cosineAt(k)), kBounds); };
+  auto bucketAt = [&](int k) { return directionBucket(cosineAt(k)); };
   // The walk starts at the steepest edge, the surest of its side.
   int start = 0;
   for (int k = 1; k < n; ++k)
     if (std::fabs(cosineAt(k)) > std::fabs(cosineAt(start))) start = k;
   fanLabels_.resize(size_t(n));
   slotSides_.resize(size_t(n));
-  int cuts = 0, lastCut = -1;
+  int cuts = 0, firstCut = -1;
   uint8_t side;  // of the arc the walk is in
   const int next = (start + 1) % n;
   if (coder.bit(startCutModels_[bucketAt(start)], recorded(start) == 4)) {
     cuts = 1;
-    lastCut = start;
+    firstCut = start;
     fanLabels_[size_t(start)] = 4;
     // The arc after the cut: the next edge's side, or, when that is the
     // other cut, the opposite of the edge after it.
@@ -523,12 +529,7 @@ void VertexSplitter::codeFanExpansion(Coder& coder) {
     if ((cuts == 0 && left == 2) || (cuts == 1 && left == 1)) {
       cut = true;  // the cuts still missing must be the last edges
     } else if (cuts < 2) {
-      int band = 0;
-      if (lastCut >= 0) {
-        const int apart = std::abs(k - lastCut);
-        const int distance = std::min(apart, n - apart), half = n / 2;
-        band = distance >= half ? 4 : distance == half - 1 ? 3 : distance == half - 2 ? 2 : 1;
-      }
+      const int band = firstCut >= 0 ? cutBand(k, firstCut) : 0;
       const bool longer = lengths_[fanOrder_[size_t(k)] - firstEdge] > meanLength_;
       int context = cuts;
       context = context * 2 + (sideAt(k) == side);
@@ -543,7 +544,7 @@ void VertexSplitter::codeFanExpansion(Coder& coder) {
     }
     if (cut) {
       ++cuts;
-      lastCut = k;
+      firstCut = cuts == 1 ? k : firstCut;
       side = uint8_t(3 - side);
     }
     fanLabels_[size_t(k)] = cut ? 4 : side;
