@@ -709,6 +709,16 @@ const std::vector<uint32_t>& VertexSplitter::triangleNeighbours(const Entry& fro
 }
 
 int VertexSplitter::predictFlip(int dimension, uint32_t simplex, const Entry& from, bool isCopy, int& voteClass) {
+  // A fan expansion adds one triangle v c v2 per cut edge v c (its only
+  // orientation decisions): it is oriented as the fan triangle through v c
+  // that stays at v, the one of its two neighbours on the fan whose arc
+  // went to v.
+  if (fanExpansionCoded_) {
+    const int n = fanSize_, before = (from.fanIndex + n - 1) % n;
+    const int slot = slotSides_[size_t(before)] == 1 ? before : from.fanIndex;
+    neighbours_.assign(1, star_[slotTriangles_[size_t(slot)]].simplex);
+    return voteOnFlip<3>(simplex, neighbours_, voteClass);
+  }
   // Stars small enough to vote without the facet index (see around()).
   if (dimension == 2 && star_.size() * 2 <= kIndexedStar) {
     const int flip = voteOnFlip<3>(simplex, triangleNeighbours(from, isCopy), voteClass);

@@ -361,6 +361,9 @@ class VertexSplitter {
   static constexpr int kFanCutClasses = 2 * 2 * 2 * 2 * 4 * 4 * 2 * kCutBands * 4;
   BitModel fanCutModels_[kFanCutClasses];
   std::vector<uint8_t> fanLabels_, slotSides_;  // per fan position: edge code, triangle side
+  // Per fan position, the star index of its triangle.
+  std::vector<uint32_t> slotTriangles_;
+  bool fanExpansionCoded_ = false;  // the split under way was coded by codeFanExpansion()
   // Orientation models: [dimension - 2][copy or new][vote class][face of higher].
   BitModel orientationModels_[2][2][3][2];
   std::optional<LabelCoder> labels_;
@@ -557,11 +560,15 @@ void VertexSplitter::codeFanExpansion(Coder& coder) {
     star_[fanOrder_[size_t(k)]].code = code;
     ++statistics_.codes[1][code - 1];
   }
+  slotTriangles_.resize(size_t(n));
   for (size_t t = begin_[2]; t < begin_[3]; ++t) {
-    const uint8_t code = slotSides_[size_t(fanSlot(star_[t]))];
+    const int slot = fanSlot(star_[t]);
+    slotTriangles_[size_t(slot)] = uint32_t(t);
+    const uint8_t code = slotSides_[size_t(slot)];
     star_[t].code = code;
     ++statistics_.codes[2][code - 1];
   }
+  fanExpansionCoded_ = true;
   ++statistics_.fanExpansions;
 }
 
@@ -579,6 +586,7 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int
   // The encoder's records come in canonical order.
   for (Entry& entry : star_) entry.record = oracle();
   bool coded = false;
+  fanExpansionCoded_ = false;
   if (fanExpansions_ && geometric && closedFanStar()) {
     const int sizeClass = std::min(fanSize_, 9) - 3;
     coded = coder.bit(fanExpansionModels_[sizeClass][balance], recordsFormFanExpansion());
