@@ -506,17 +506,22 @@ bool PositionPredictor::gatherAlongAxis(uint32_t vertex, int level, Neighbourhoo
   if (vertex >= store_.vertexCapacity() || vertex >= places_.size()) return false;
   const int axis = axis_[size_t(level)];
   const double inverseHalfWidth = inverseHalfWidths_[size_t(level)];
-  const double atAxis = places_[vertex].centre[axis];
   const Place* places = places_.data();
-  around.alongAxis = {};
+  const double atAxis = places[vertex].centre[axis];
+  // A walk over local pointers and bins (SimplexStore::lists()); an edge's
+  // slots are 2 · edge + position, so the other end's slot is slot ^ 1.
+  const SimplexStore::Lists edges = store_.lists(1);
+  std::array<uint32_t, 10> bins{};
   double sum = 0;  // of the neighbours' offsets along the axis, in half widths
   uint32_t count = 0;
-  store_.forEachIncident(1, vertex, [&](uint32_t edge, uint32_t position) {
-    const double offset = (places[store_.vertices(1, edge)[1 - position]].centre[axis] - atAxis) * inverseHalfWidth;
-    ++around.alongAxis[size_t(alongBin(offset))];
+  for (uint32_t slot = edges.heads[vertex]; slot != kNoSimplex; slot = edges.next[slot]) {
+    if (!edges.alive(slot >> 1)) continue;
+    const double offset = (places[edges.vertices[slot ^ 1]].centre[axis] - atAxis) * inverseHalfWidth;
+    ++bins[size_t(alongBin(offset))];
     sum += offset;
     ++count;
-  });
+  }
+  around.alongAxis = bins;
   if (count == 0) return false;
   centroid = sum / double(count);
   return true;

@@ -35,13 +35,14 @@ uint32_t SimplexStore::add(int dimension, const uint32_t* vertices, uint8_t flag
   const size_t arity = size_t(dimension + 1);
   // Slots are simplex * arity + position in 32 bits.
   if (simplex >= pool.capacity || simplex >= 0xfffffff0u / arity) return kNoSimplex;
-  pool.vertices.insert(pool.vertices.end(), vertices, vertices + arity);
   pool.flags.push_back(uint8_t(flags | kAlive));
   if (labelled_) pool.labels.push_back(label);
   ++live_[dimension];
-  // Slots pushed one by one: resize() was an out-of-line call in the
-  // decoder's third most frequent function.
+  // Vertices and slots pushed one by one: resize() and a range insert()
+  // are out-of-line calls, and this is one of the decoder's most frequent
+  // functions.
   for (uint32_t i = 0; i < arity; ++i) {
+    pool.vertices.push_back(vertices[i]);
     pool.next.push_back(kNoSimplex);
     link(dimension, simplex, i);
   }
