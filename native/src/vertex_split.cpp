@@ -154,33 +154,17 @@ int directionBucket(double cosine) {
 
 // Where each edge's other vertex lies against the split: the cosine of the
 // angle between the split axis and the direction from v's cell centre to
-// it. Negative cosines point to v's half, positive ones to v2's; the two
-// edges that become triangles (code 4) of an edge expansion lie where the
-// fan crosses the split plane, hence whether a fan neighbour lies on the
-// other side, and which of the two is closer to the plane. Those two are
-// also the apexes of the triangles on the new edge v v2, which lie close
-// to it: a neighbour farther from v than the star's mean is less likely cut
-// (the paper's Delaunay criterion, coarsely).
-// Class 0: no geometry (splits of coincident vertices).
-void VertexSplitter::classifyEdges(uint32_t v, int level) {
+// it (negative: towards v's half, positive: towards v2's), and its length.
+void VertexSplitter::measureEdges(uint32_t v, int level) {
   const size_t first = begin_[1], last = begin_[2];
   halfWidth_ = 0;
-  if (!geometry_.geometric(level)) {
-    for (size_t i = first; i < last; ++i) star_[i].geometry = 0;
-    return;
-  }
+  if (!geometry_.geometric(level)) return;
   halfWidth_ = 1.0 / geometry_.inverseHalfWidth(level);
   cosines_.resize(last - first);
   lengths_.resize(last - first);
-  statistics_.edgeCodesByDirection += last - first;
   const int axis = geometry_.axis(level);
   double from[3];
   geometry_.centreOf(v, from);
-  // In a tetrahedral mesh an edge has many fan neighbours and no crossing
-  // to speak of; what tells a cut edge there is its length against the
-  // cell: a neighbour within a cell width or so of v lies near the split
-  // plane's patch between v and v2, which the crossing class does not see.
-  const bool volume = begin_[4] > begin_[3];
   double meanLength = 0;
   for (size_t i = first; i < last; ++i) {
     double to[3], squared = 0;
@@ -193,16 +177,37 @@ void VertexSplitter::classifyEdges(uint32_t v, int level) {
     lengths_[i - first] = length;
     meanLength += length;
     cosines_[i - first] = squared > 0 ? to[axis] / length : 0;
-    if (volume) {
+  }
+  meanLength_ = last > first ? meanLength / double(last - first) : 0;
+}
+
+// The two edges that become triangles (code 4) of an edge expansion lie
+// where the fan crosses the split plane, hence whether a fan neighbour lies
+// on the other side, and which of the two is closer to the plane. Those two
+// are also the apexes of the triangles on the new edge v v2, which lie
+// close to it: a neighbour farther from v than the star's mean is less
+// likely cut (the paper's Delaunay criterion, coarsely).
+// Class 0: no geometry (splits of coincident vertices).
+void VertexSplitter::classifyEdges() {
+  const size_t first = begin_[1], last = begin_[2];
+  if (halfWidth_ == 0) {
+    for (size_t i = first; i < last; ++i) star_[i].geometry = 0;
+    return;
+  }
+  statistics_.edgeCodesByDirection += last - first;
+  // In a tetrahedral mesh an edge has many fan neighbours and no crossing
+  // to speak of; what tells a cut edge there is its length against the
+  // cell: a neighbour within a cell width or so of v lies near the split
+  // plane's patch between v and v2, which the crossing class does not see.
+  if (begin_[4] > begin_[3]) {
+    for (size_t i = first; i < last; ++i) {
       // Length in half widths of the cell along the split axis.
       static constexpr double kReachBounds[2] = {2, 3};
-      const int reach = countAtMost(length * geometry_.inverseHalfWidth(level), kReachBounds);
+      const int reach = countAtMost(lengths_[i - first] / halfWidth_, kReachBounds);
       star_[i].geometry = uint8_t(1 + reach * 8 + directionBucket(cosines_[i - first]));
     }
+    return;
   }
-  if (volume) return;
-  meanLength /= double(last - first);
-  meanLength_ = meanLength;
   for (size_t i = first; i < last; ++i) {
     const double cosine = cosines_[i - first], magnitude = std::fabs(cosine);
     // Between a fan neighbour on v's side and one on v2's side lies a cut
@@ -215,7 +220,7 @@ void VertexSplitter::classifyEdges(uint32_t v, int level) {
       crossing = magnitude <= std::fabs(theirs) ? 1 : std::max(crossing, 2);
       if (crossing == 1) break;
     }
-    const bool longer = lengths_[i - first] > meanLength;
+    const bool longer = lengths_[i - first] > meanLength_;
     star_[i].geometry = uint8_t(1 + ((longer * 3 + crossing) * 2 + (cosine > 0)) * 4 + directionBucket(cosine));
   }
 }

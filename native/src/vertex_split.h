@@ -89,7 +89,7 @@ struct StarEntry {
   uint8_t position;    // of the vertex in the simplex's tuple
   uint8_t code;
   uint8_t record;
-  uint8_t geometry;  // edges: class of the other vertex's direction (see classifyEdges)
+  uint8_t geometry;  // edges: class of the other vertex's direction (see classifyEdges())
   uint8_t fanCodes;  // edges: codes already given to fan neighbours, bits 0 (1), 1 (2), 2 (3 or 4)
   // Cut edges (coded 3 or 4): how many triangles through them were coded 4,
   // and how many between them and another cut edge are still to be coded.
@@ -185,7 +185,10 @@ class VertexSplitter {
 
   uint8_t possibleCodes(const Entry& entry) const;
   const Entry* findFace(int dimension, const uint32_t* others) const;
-  void classifyEdges(uint32_t v, int level);
+  // The cosines and lengths of the star's edges (classifyEdges()).
+  void measureEdges(uint32_t v, int level);
+  // Their direction classes, for the codes of codeEntries().
+  void classifyEdges();
   void orderCodes(bool geometric);
   void linkFans();
   void indexFan();
@@ -344,7 +347,7 @@ class VertexSplitter {
   std::vector<uint32_t> fanOrder_;
   int firstCut_ = -1;     // fan position of the first edge coded 4
   double halfWidth_ = 0;  // of the split cell along the split axis (0: not geometric)
-  double meanLength_ = 0;  // of the star's edges (classifyEdges(), surface stars)
+  double meanLength_ = 0;  // of the star's edges (measureEdges())
   // Fan expansions (streams coded for fast decoding): whether the closed
   // fan's split is one, by fan size (3..9 and more) and splitBalance().
   const bool fanExpansions_;
@@ -405,6 +408,7 @@ void VertexSplitter::decideOrientation(Coder& coder, int dimension, uint32_t sim
 
 template <class Coder>
 bool VertexSplitter::codeEntries(Coder& coder, bool geometric, int balance, int& cutEdges, bool& codedThree) {
+  classifyEdges();
   orderCodes(geometric);
   const bool volume = begin_[4] > begin_[3];  // the star holds a tetrahedron
   size_t pairedTriangles = 0;
@@ -578,7 +582,7 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int
   newVertex_ = v2;
   gatherStar(store_, v, star_, begin_);
   linkFans();
-  classifyEdges(v, level);
+  measureEdges(v, level);
   const bool geometric = geometry_.geometric(level);
   ++statistics_.vertexSplits;
   int cutEdges = 0;  // edges coded 4: an edge expansion has two
