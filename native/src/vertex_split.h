@@ -363,7 +363,7 @@ class VertexSplitter {
   // lies from the first cut (cutBand()); edges left (1, 2, 3+).
   static constexpr int kFanCutClasses = 2 * 2 * 2 * 2 * 4 * 4 * 2 * kCutBands * 4;
   BitModel fanCutModels_[kFanCutClasses];
-  std::vector<uint8_t> fanLabels_, slotSides_;  // per fan position: edge code, triangle side
+  std::vector<uint8_t> slotSides_;  // per fan position, the code of its triangle
   // Per fan position, the star index of its triangle.
   std::vector<uint32_t> slotTriangles_;
   bool fanExpansionCoded_ = false;  // the split under way was coded by codeFanExpansion()
@@ -510,15 +510,19 @@ void VertexSplitter::codeFanExpansion(Coder& coder) {
   int start = 0;
   for (int k = 1; k < n; ++k)
     if (std::fabs(cosineAt(k)) > std::fabs(cosineAt(start))) start = k;
-  fanLabels_.resize(size_t(n));
   slotSides_.resize(size_t(n));
+  // Each edge's code goes straight to its star entry.
+  auto give = [&](int k, uint8_t code) {
+    star_[fanOrder_[size_t(k)]].code = code;
+    ++statistics_.codes[1][code - 1];
+  };
   int cuts = 0, firstCut = -1;
   uint8_t side;  // of the arc the walk is in
   const int next = (start + 1) % n;
   if (coder.bit(startCutModels_[bucketAt(start)], recorded(start) == 4)) {
     cuts = 1;
     firstCut = start;
-    fanLabels_[size_t(start)] = 4;
+    give(start, 4);
     // The arc after the cut: the next edge's side, or, when that is the
     // other cut, the opposite of the edge after it.
     const uint8_t arc = recorded(next) != 4 ? recorded(next) : uint8_t(3 - recorded((next + 1) % n));
@@ -526,7 +530,7 @@ void VertexSplitter::codeFanExpansion(Coder& coder) {
   } else {
     side = uint8_t(coder.bit(startSideModels_[bucketAt(start)], recorded(start) != sideAt(start)) ? 3 - sideAt(start)
                                                                                                  : sideAt(start));
-    fanLabels_[size_t(start)] = side;
+    give(start, side);
   }
   slotSides_[size_t(start)] = side;
   for (int step = 1; step < n; ++step) {
@@ -550,20 +554,14 @@ void VertexSplitter::codeFanExpansion(Coder& coder) {
       cut = coder.bit(fanCutModels_[context], recorded(k) == 4);
     }
     if (cut) {
-      ++cuts;
-      firstCut = cuts == 1 ? k : firstCut;
+      if (++cuts == 1) firstCut = k;
       side = uint8_t(3 - side);
     }
-    fanLabels_[size_t(k)] = cut ? 4 : side;
+    give(k, cut ? 4 : side);
     slotSides_[size_t(k)] = side;
   }
   star_[0].code = 4;
   ++statistics_.codes[0][3];
-  for (int k = 0; k < n; ++k) {
-    const uint8_t code = fanLabels_[size_t(k)];
-    star_[fanOrder_[size_t(k)]].code = code;
-    ++statistics_.codes[1][code - 1];
-  }
   slotTriangles_.resize(size_t(n));
   for (size_t t = begin_[2]; t < begin_[3]; ++t) {
     const int slot = fanSlot(star_[t]);
