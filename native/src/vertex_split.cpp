@@ -333,11 +333,18 @@ void VertexSplitter::linkFans() {
       ++crowdedLinks_;
     }
   };
+  // A triangle's edges through v are found by their other vertex in
+  // edgeTo_, which each split fills for its own edges: an entry left by an
+  // earlier split names no edge of this star to that vertex.
+  if (edgeTo_.size() < store_.vertexCapacity()) edgeTo_.resize(store_.vertexCapacity());
+  for (size_t i = begin_[1]; i < begin_[2]; ++i) edgeTo_[star_[i].others[0]] = uint32_t(i);
+  auto edgeTo = [this](uint32_t vertex) {
+    const uint32_t i = edgeTo_[vertex];
+    return i >= begin_[1] && i < begin_[2] && star_[i].others[0] == vertex ? i : kNoSimplex;
+  };
   for (size_t i = begin_[2]; i < begin_[3]; ++i) {
-    const Entry* first = findFace(1, &star_[i].others[0]);
-    const Entry* second = findFace(1, &star_[i].others[1]);
-    if (first == nullptr || second == nullptr) continue;
-    const uint32_t a = uint32_t(first - star_.data()), b = uint32_t(second - star_.data());
+    const uint32_t a = edgeTo(star_[i].others[0]), b = edgeTo(star_[i].others[1]);
+    if (a == kNoSimplex || b == kNoSimplex) continue;
     star_[i].links[0] = a;
     star_[i].links[1] = b;
     link(a, b);
@@ -597,7 +604,9 @@ void VertexSplitter::countDecided(int dimension, uint32_t simplex) {
 }
 
 bool VertexSplitter::isFaceOfHigher(int dimension, uint32_t simplex) {
-  if (dimension >= SimplexStore::kMaxDimension) return false;
+  // A complex without simplices one dimension up (a surface's has no
+  // tetrahedra) has nothing to look up.
+  if (dimension >= SimplexStore::kMaxDimension || store_.size(dimension + 1) == 0) return false;
   // around() lists at most two simplices per star entry: a smaller star
   // gets no index.
   if (star_.size() * 2 > kIndexedStar) {
@@ -635,37 +644,42 @@ VertexSplitter::FacetKey VertexSplitter::facetKey(int dimension, uint32_t simple
 // The vote of predictFlip for simplices of kArity vertices, the arity known
 // at compile time so that the comparisons unroll without branches. A
 // neighbour is a decided simplex one vertex apart (sharing a facet), and
-// it votes for the orientation that makes the two consistent.
+// it votes for the orientation that makes the two consistent: 1 flip, -1
+// keep, 0 for a simplex that is no decided neighbour.
+template <int kArity>
+int VertexSplitter::neighbourVote(uint32_t simplex, int myParity, uint32_t other) const {
+  constexpr int kDimension = kArity - 1;
+  if (other == simplex || (store_.flags(kDimension, other) & SimplexStore::kUndecided)) return 0;
+  const uint32_t* mine = store_.vertices(kDimension, simplex);
+  const uint32_t* theirs = store_.vertices(kDimension, other);
+  // Neighbours share all vertices but one each; most candidates share
+  // only the split's vertex, so theirs are looked at only after mine.
+  int mineShared = 0, theirsShared = 0;  // bit i: vertex i is in the other
+  for (int i = 0; i < kArity; ++i) mineShared |= int(containsVertex(theirs, kArity, mine[i])) << i;
+  constexpr int kAll = (1 << kArity) - 1;
+  const int mineOnly = kAll ^ mineShared;
+  if (mineOnly & (mineOnly - 1) || mineOnly == 0) return 0;  // not exactly one vertex apart
+  for (int i = 0; i < kArity; ++i) theirsShared |= int(containsVertex(mine, kArity, theirs[i])) << i;
+  const int theirsOnly = kAll ^ theirsShared;
+  // Orientation each induces on the shared facet; consistent neighbours
+  // induce opposite ones.
+  const int mySign = myParity ^ (rankOf(mine, kArity, mine[__builtin_ctz(unsigned(mineOnly))]) & 1);
+  const int theirSign =
+      store_.parity(kDimension, other) ^ (rankOf(theirs, kArity, theirs[__builtin_ctz(unsigned(theirsOnly))]) & 1);
+  return mySign == theirSign ? 1 : -1;
+}
+
 template <int kArity>
 int VertexSplitter::voteOnFlip(uint32_t simplex, const std::vector<uint32_t>& candidates, int& voteClass) {
   constexpr int kDimension = kArity - 1;
-  const uint32_t* mine = store_.vertices(kDimension, simplex);
-  const int myParity = store_.parity(kDimension, simplex);
   int keep = 0, flip = 0;
-  auto vote = [&](uint32_t other) {
-    if (other == simplex || (store_.flags(kDimension, other) & SimplexStore::kUndecided)) return;
-    const uint32_t* theirs = store_.vertices(kDimension, other);
-    // Neighbours share all vertices but one each; most candidates share
-    // only the split's vertex, so theirs are looked at only after mine.
-    int mineShared = 0, theirsShared = 0;  // bit i: vertex i is in the other
-    for (int i = 0; i < kArity; ++i) mineShared |= int(containsVertex(theirs, kArity, mine[i])) << i;
-    constexpr int kAll = (1 << kArity) - 1;
-    const int mineOnly = kAll ^ mineShared;
-    if (mineOnly & (mineOnly - 1) || mineOnly == 0) return;  // not exactly one vertex apart
-    for (int i = 0; i < kArity; ++i) theirsShared |= int(containsVertex(mine, kArity, theirs[i])) << i;
-    const int theirsOnly = kAll ^ theirsShared;
-    // Orientation each induces on the shared facet; consistent neighbours
-    // induce opposite ones.
-    const int mySign = myParity ^ (rankOf(mine, kArity, mine[__builtin_ctz(unsigned(mineOnly))]) & 1);
-    const int theirSign =
-        store_.parity(kDimension, other) ^ (rankOf(theirs, kArity, theirs[__builtin_ctz(unsigned(theirsOnly))]) & 1);
-    if (mySign == theirSign)
-      ++flip;
-    else
-      ++keep;
-  };
   if (facets_[size_t(kDimension)].empty()) {
-    for (const uint32_t other : candidates) vote(other);
+    const int myParity = store_.parity(kDimension, simplex);
+    for (const uint32_t other : candidates) {
+      const int vote = neighbourVote<kArity>(simplex, myParity, other);
+      flip += vote > 0;
+      keep += vote < 0;
+    }
   } else {
     // The same count: two distinct simplices share at most one facet, and
     // the simplex being decided is not counted yet.
@@ -719,10 +733,11 @@ int VertexSplitter::predictFlip(int dimension, uint32_t simplex, const Entry& fr
   // that stays at v, the one of its two neighbours on the fan whose arc
   // went to v.
   if (fanExpansionCoded_) {
-    const int n = fanSize_, before = (from.fanIndex + n - 1) % n;
+    const int before = (from.fanIndex == 0 ? fanSize_ : from.fanIndex) - 1;
     const int slot = slotSides_[size_t(before)] == 1 ? before : from.fanIndex;
-    neighbours_.assign(1, star_[slotTriangles_[size_t(slot)]].simplex);
-    return voteOnFlip<3>(simplex, neighbours_, voteClass);
+    const int vote = neighbourVote<3>(simplex, store_.parity(2, simplex), star_[slotTriangles_[size_t(slot)]].simplex);
+    voteClass = vote != 0;
+    return vote > 0;
   }
   // Stars small enough to vote without the facet index (see around()).
   if (dimension == 2 && star_.size() * 2 <= kIndexedStar) {

@@ -254,6 +254,8 @@ class VertexSplitter {
   // triangle made from `from` (predictFlip()).
   const std::vector<uint32_t>& triangleNeighbours(const Entry& from, bool isCopy);
   template <int kArity>
+  int neighbourVote(uint32_t simplex, int myParity, uint32_t other) const;
+  template <int kArity>
   int voteOnFlip(uint32_t simplex, const std::vector<uint32_t>& candidates, int& voteClass);
 
   SimplexStore& store_;
@@ -270,6 +272,8 @@ class VertexSplitter {
   int crowdedLinks_ = 0;
   bool crowdedFans() const { return crowdedLinks_ > 0; }
   std::vector<uint32_t> fanStart_, fanList_, fanFill_;
+  // Per vertex id, the star_ index of the edge to it (linkFans()).
+  std::vector<uint32_t> edgeTo_;
   std::array<size_t, 5> begin_{};  // star_ entries of dimension d: [begin_[d], begin_[d+1])
   // Simplices of dimension d at v or v2 after the split, gathered on the
   // first orientation decision of that dimension (most splits of a surface
