@@ -340,13 +340,13 @@ void PositionPredictor::forgetAcross(uint32_t triangle, uint32_t position) {
 // memory (docs/EXPERIMENTS.md).
 template <bool kParallelograms>
 bool PositionPredictor::gather(uint32_t vertex, int level, Neighbourhood& around) {
-  if (vertex >= store_.vertexCapacity() || vertex >= places_.size()) return false;
+  if (vertex >= store_.vertexCapacity() || !placed(vertex)) return false;
   const int axis = axis_[size_t(level)];
   const double inverseHalfWidth = inverseHalfWidths_[size_t(level)];
   std::array<uint32_t, 10> alongAxis{};
   // Scalars rather than arrays: these loops, the decoder's hottest, stalled
   // on store-to-load forwarding with array temporaries.
-  const double* at = places_[vertex].centre;
+  const double* at = centre(vertex);
   const double atX = at[0], atY = at[1], atZ = at[2], atAxis = at[axis];
   double sumX = 0, sumY = 0, sumZ = 0, normalX = 0, normalY = 0, normalZ = 0, squared = 0, along = 0;
   uint32_t count = 0, parallelograms = 0;
@@ -356,7 +356,7 @@ bool PositionPredictor::gather(uint32_t vertex, int level, Neighbourhood& around
   // registers (through the vectors, each store in the loop made the
   // compiler load them again).
   const SimplexStore::Lists triangles = store_.lists(2);
-  const Place* places = places_.data();
+  const double* centres = centres_.data();
   const uint32_t* acrossSlots = acrossSlots_.data();
   double* predictions = predictions_.data();
   uint32_t room = uint32_t(predictions_.size());
@@ -369,8 +369,8 @@ bool PositionPredictor::gather(uint32_t vertex, int level, Neighbourhood& around
     const uint32_t* tuple = triangles.vertices + size_t(triangle) * 3;
     const uint32_t row = slot - triangle * 3 + (triangles.flags[triangle] & SimplexStore::kFlipped ? 3 : 0);
     const uint32_t next = tuple[kNext[row]], afterNext = tuple[kAfterNext[row]];
-    const double* a = places[next].centre;
-    const double* b = places[afterNext].centre;
+    const double* a = centres + size_t(next) * 3;
+    const double* b = centres + size_t(afterNext) * 3;
     const double ax = a[0] - atX, ay = a[1] - atY, az = a[2] - atZ;
     const double bx = b[0] - atX, by = b[1] - atY, bz = b[2] - atZ;
     const double aAlong = a[axis] - atAxis;
@@ -396,7 +396,7 @@ bool PositionPredictor::gather(uint32_t vertex, int level, Neighbourhood& around
         predictions = predictions_.data();
         room = uint32_t(predictions_.size());
       }
-      const double* c = places[triangles.vertices[farSlot]].centre;
+      const double* c = centres + size_t(triangles.vertices[farSlot]) * 3;
       predictions[parallelograms++] = aAlong + (b[axis] - atAxis) - (c[axis] - atAxis);
     }
   }
@@ -410,16 +410,16 @@ bool PositionPredictor::gather(uint32_t vertex, int level, Neighbourhood& around
   // No triangle: the other ends of the edges.
   double previousX = 0, previousY = 0, previousZ = 0;  // the first cross product is zero
   store_.forEachIncident(1, vertex, [&](uint32_t edge, uint32_t position) {
-    const double* centre = places_[store_.vertices(1, edge)[1 - position]].centre;
-    const double x = centre[0] - atX, y = centre[1] - atY, z = centre[2] - atZ;
+    const double* other = centre(store_.vertices(1, edge)[1 - position]);
+    const double x = other[0] - atX, y = other[1] - atY, z = other[2] - atZ;
     sumX += x;
     sumY += y;
     sumZ += z;
     squared += x * x;
     squared += y * y;
     squared += z * z;
-    along += (centre[axis] - atAxis) * (centre[axis] - atAxis);
-    ++alongAxis[size_t(alongBin((centre[axis] - atAxis) * inverseHalfWidth))];
+    along += (other[axis] - atAxis) * (other[axis] - atAxis);
+    ++alongAxis[size_t(alongBin((other[axis] - atAxis) * inverseHalfWidth))];
     const double crossX = previousY * z - previousZ * y;
     const double crossY = previousZ * x - previousX * z;
     const double crossZ = previousX * y - previousY * x;
@@ -455,8 +455,8 @@ bool PositionPredictor::gatherFromProxy(uint32_t vertex, int level, Neighbourhoo
   }
   if (!found) return false;
   const int axis = axis_[size_t(level)];
-  const double* from = places_[vertex].centre;
-  const double* to = places_[proxy].centre;
+  const double* from = centre(vertex);
+  const double* to = centre(proxy);
   around.squaredDistance = 0;
   for (int a = 0; a < 3; ++a) {
     around.sum[a] = to[a] - from[a];
@@ -469,6 +469,30 @@ bool PositionPredictor::gatherFromProxy(uint32_t vertex, int level, Neighbourhoo
   ++around.alongAxis[size_t(alongBin(around.sum[axis] * inverseHalfWidths_[size_t(level)]))];
   ++proxyPredictions_;
   return true;
+}
+
+// The neighbours of the cell's slab that went to its upper half, to its
+// lower half and those not split yet (up to 3 each), then whether any
+// neighbour lies in the half of each slab beside the cell that touches it,
+// already split; whether any not split yet lies in each of those slabs;
+// and with `farHalves`, whether any already split lies in the far half of
+// each: 64 · 4 · 4 (· 4) classes. Mirroring reverses the axis, and so the
+// bins: bin i is read as bin 8 − i.
+int PositionPredictor::refinementClass(const AlongAxisBins& bins, bool mirrored, bool farHalves) {
+  refinedNeighbourPredictions_ += bins[3] + bins[5] > 0;
+  // The class is read both ways and one reading kept: which applies is a
+  // coin toss for the branch predictor, and a choice per bin costs more.
+  auto classFrom = [&bins, farHalves](size_t origin, int step) {
+    auto bin = [&](size_t i) { return bins[size_t(int(origin) + step * int(i))]; };
+    auto upTo3 = [&bin](size_t i) { return std::min(bin(i), 3u); };
+    auto pair = [&bin](size_t above, size_t below) { return uint32_t(bin(above) > 0) * 2 + uint32_t(bin(below) > 0); };
+    uint32_t c = (upTo3(5) * 4 + upTo3(3)) * 4 + upTo3(4);
+    c = (c * 4 + pair(6, 2)) * 4 + pair(7, 1);
+    if (farHalves) c = c * 4 + pair(8, 0);
+    return c;
+  };
+  const uint32_t upward = classFrom(0, 1), downward = classFrom(8, -1);
+  return int(mirrored ? downward : upward);
 }
 
 bool PositionPredictor::contextsOf(uint32_t vertex, int level, SingleContexts& c) {
@@ -496,32 +520,32 @@ bool PositionPredictor::contextsOf(uint32_t vertex, int level, SingleContexts& c
   c.parallelogram =
       (plane * kSpreadClasses + spreadClass(f.parallelogramSpread)) * kParallelogramBuckets + f.parallelogram;
   parallelogramPredictions_ += f.hasParallelogram;
-  c.refinement = refinementClass(around, f.mirrored, true) * 2 + (tilt >= 2);
+  c.refinement = refinementClass(around.alongAxis, f.mirrored, true) * 2 + (tilt >= 2);
   c.parallelogramOdds.fast = c.parallelogramOdds.slow =
       f.hasParallelogram ? parallelogramOdds(f.parallelogramOffset, f.parallelogramSpread) : kProbabilityOne / 2;
   return true;
 }
 
-bool PositionPredictor::gatherAlongAxis(uint32_t vertex, int level, Neighbourhood& around, double& centroid) {
-  if (vertex >= store_.vertexCapacity() || vertex >= places_.size()) return false;
+bool PositionPredictor::gatherAlongAxis(uint32_t vertex, int level, AlongAxisBins& bins, double& centroid) {
+  bins = {};
+  if (vertex >= store_.vertexCapacity() || !placed(vertex)) return false;
   const int axis = axis_[size_t(level)];
   const double inverseHalfWidth = inverseHalfWidths_[size_t(level)];
-  const Place* places = places_.data();
-  const double atAxis = places[vertex].centre[axis];
-  // A walk over local pointers and bins (SimplexStore::lists()); an edge's
-  // slots are 2 · edge + position, so the other end's slot is slot ^ 1.
+  // The centres' coordinates along the axis, three doubles apart.
+  const double* along = centres_.data() + axis;
+  const double atAxis = along[size_t(vertex) * 3];
+  // A walk over local pointers (SimplexStore::lists()); an edge's slots are
+  // 2 · edge + position, so the other end's slot is slot ^ 1.
   const SimplexStore::Lists edges = store_.lists(1);
-  std::array<uint32_t, 10> bins{};
   double sum = 0;  // of the neighbours' offsets along the axis, in half widths
   uint32_t count = 0;
   for (uint32_t slot = edges.heads[vertex]; slot != kNoSimplex; slot = edges.next[slot]) {
     if (!edges.alive(slot >> 1)) continue;
-    const double offset = (places[edges.vertices[slot ^ 1]].centre[axis] - atAxis) * inverseHalfWidth;
+    const double offset = (along[size_t(edges.vertices[slot ^ 1]) * 3] - atAxis) * inverseHalfWidth;
     ++bins[size_t(alongBin(offset))];
     sum += offset;
     ++count;
   }
-  around.alongAxis = bins;
   if (count == 0) return false;
   centroid = sum / double(count);
   return true;
@@ -529,28 +553,28 @@ bool PositionPredictor::gatherAlongAxis(uint32_t vertex, int level, Neighbourhoo
 
 bool PositionPredictor::alongAxisContext(uint32_t vertex, int level, int& context, bool& mirrored) {
   static_assert(kAlongAxisModels == kFamilySize[int(ModelFamily::OneVertexAlongAxis)]);
-  Neighbourhood around;
+  AlongAxisBins bins;
   double centroid = 0;
-  if (!gatherAlongAxis(vertex, level, around, centroid)) return false;
+  if (!gatherAlongAxis(vertex, level, bins, centroid)) return false;
   ++positionPredictions_;
   mirrored = centroid < 0;
   const double offset = std::fabs(centroid);
   const int bucket = offset < 0.25 ? 0 : offset < 0.75 ? 1 : offset < 1.5 ? 2 : 3;
-  context = refinementClass(around, mirrored, false) * kAlongAxisCentroidBuckets + bucket;
+  context = refinementClass(bins, mirrored, false) * kAlongAxisCentroidBuckets + bucket;
   return true;
 }
 
 // The class by where the centroid lies, as for a vertex in no triangle.
 CountContext PositionPredictor::alongAxisCountContext(uint32_t vertex, int level) {
-  Neighbourhood around;
+  AlongAxisBins bins;
   double centroid = 0;
-  if (!gatherAlongAxis(vertex, level, around, centroid)) return {};
+  if (!gatherAlongAxis(vertex, level, bins, centroid)) return {};
   ++countPredictions_;
   CountContext context;
   context.mirrored = centroid < 0;
   const double offset = std::fabs(centroid);
   context.neighbourhoodClass = offset < 0.5 ? 10 : offset < 1.5 ? 11 : 12;
-  context.refinement = refinementClass(around, context.mirrored, false);
+  context.refinement = refinementClass(bins, context.mirrored, false);
   return context;
 }
 
@@ -563,26 +587,8 @@ CountContext PositionPredictor::countContext(uint32_t vertex, int level, bool pa
   parallelogramPredictions_ += f.hasParallelogram;
   CountContext context = countContextOf(f);
   context.parallelogram = f.parallelogram;
-  context.refinement = refinementClass(around, f.mirrored, false);
+  context.refinement = refinementClass(around.alongAxis, f.mirrored, false);
   return context;
-}
-
-// The neighbours of the cell's slab that went to its upper half, to its
-// lower half and those not split yet (up to 3 each), then whether any
-// neighbour lies in the half of each slab beside the cell that touches it,
-// already split; whether any not split yet lies in each of those slabs;
-// and with `farHalves`, whether any already split lies in the far half of
-// each: 64 · 4 · 4 (· 4) classes. Mirroring reverses the axis, and so the
-// bins: bin i is read as bin 8 − i.
-int PositionPredictor::refinementClass(const Neighbourhood& around, bool mirrored, bool farHalves) {
-  auto bin = [&around, mirrored](size_t i) { return around.alongAxis[mirrored ? 8 - i : i]; };
-  refinedNeighbourPredictions_ += bin(3) + bin(5) > 0;
-  auto upTo3 = [&bin](size_t i) { return std::min(bin(i), 3u); };
-  auto pair = [&bin](size_t above, size_t below) { return uint32_t(bin(above) > 0) * 2 + uint32_t(bin(below) > 0); };
-  uint32_t c = (upTo3(5) * 4 + upTo3(3)) * 4 + upTo3(4);
-  c = (c * 4 + pair(6, 2)) * 4 + pair(7, 1);
-  if (farHalves) c = c * 4 + pair(8, 0);
-  return int(c);
 }
 
 CountContext PositionPredictor::countContextOf(const Features& f) {

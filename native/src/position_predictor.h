@@ -116,9 +116,9 @@ class PositionPredictor {
   // The vertex's cell is now the one at `level` with these leading
   // coordinate bits.
   void place(uint32_t vertex, const uint32_t prefix[3], int level) {
-    if (vertex >= places_.size()) places_.resize(std::max<size_t>(vertex + 1, places_.size() * 2));
+    if (!placed(vertex)) centres_.resize(std::max<size_t>(size_t(vertex) + 1, centres_.size() / 3 * 2) * 3);
     const std::array<double, 3>& width = widths_[size_t(level)];
-    for (int a = 0; a < 3; ++a) places_[vertex].centre[a] = double(prefix[a]) * width[a] + (width[a] - 1) * 0.5;
+    for (int a = 0; a < 3; ++a) centre(vertex)[a] = double(prefix[a]) * width[a] + (width[a] - 1) * 0.5;
   }
 
   // The neighbourhood class of the split of a cell of several vertices at
@@ -158,7 +158,7 @@ class PositionPredictor {
     // The half's centre lies a quarter of the cell's width below or above.
     const int axis = axis_[size_t(level)];
     const double quarter = widths_[size_t(level)][size_t(axis)] * 0.25;
-    places_[vertex].centre[axis] += first ? -quarter : quarter;
+    centre(vertex)[axis] += first ? -quarter : quarter;
     return first;
   }
 
@@ -198,7 +198,7 @@ class PositionPredictor {
   // current cell in grid units.
   int axis(int level) const { return axis_[size_t(level)]; }
   void centreOf(uint32_t vertex, double out[3]) const {
-    for (int a = 0; a < 3; ++a) out[a] = places_[vertex].centre[a];
+    for (int a = 0; a < 3; ++a) out[a] = centre(vertex)[a];
   }
 
   // Its model families, visit(family, first model), and its mixers,
@@ -230,15 +230,18 @@ class PositionPredictor {
   }
 
  private:
-  // The centre of a vertex's current cell in grid units, kept as the cell
-  // shrinks rather than computed from its coordinate bits at every look (in
-  // gather(), a second dependent load and nine operations per neighbour).
-  // Exact: centres are multiples of 1/2 below 2^32 (grids have at most 32
-  // bits).
-  struct Place {
-    double centre[3];
-  };
+  // The centre of a vertex's current cell in grid units (x, y, z at
+  // centres_[3 · vertex]), kept as the cell shrinks rather than computed
+  // from its coordinate bits at every look (in gather(), a second dependent
+  // load and nine operations per neighbour). Exact: centres are multiples
+  // of 1/2 below 2^32 (grids have at most 32 bits).
+  const double* centre(uint32_t vertex) const { return &centres_[size_t(vertex) * 3]; }
+  double* centre(uint32_t vertex) { return &centres_[size_t(vertex) * 3]; }
+  bool placed(uint32_t vertex) const { return size_t(vertex) * 3 < centres_.size(); }
 
+  // Neighbour counts by where they lie along the split axis (alongBin() in
+  // position_predictor.cpp).
+  using AlongAxisBins = std::array<uint32_t, 10>;
   // Sums over the neighbours' cell centres, relative to the vertex's cell
   // centre; the normal: see the top of this file. `oriented`: the normal
   // comes from the triangles' winding and points outside.
@@ -251,9 +254,7 @@ class PositionPredictor {
     double parallelogramMedian, parallelogramDeviation;
     uint32_t count, parallelograms;
     bool oriented;
-    // The neighbours by where they lie along the split axis (alongBin() in
-    // position_predictor.cpp).
-    std::array<uint32_t, 10> alongAxis;
+    AlongAxisBins alongAxis;
   };
   // The predictions against the split at `level`, in half widths of the
   // cell along the split axis, mirrored so that the plane (or without one,
@@ -282,7 +283,9 @@ class PositionPredictor {
   // `farHalves` (whether the far halves of the slabs beside the cell hold
   // a neighbour already split). Counts the predictions with a neighbour
   // split in the cell's slab.
-  int refinementClass(const Neighbourhood& around, bool mirrored, bool farHalves);
+  // Inlined always: on the fast path it is a few dozen instructions per
+  // one-vertex decision, and a call's share of them.
+  [[gnu::always_inline]] inline int refinementClass(const AlongAxisBins& bins, bool mirrored, bool farHalves);
   // Searches the triangle b a c across the edge a b (wound a b) and
   // returns the slot of its vertex c, or kNowhere; `slot` (triangle · 3 +
   // position) names the triangle v a b whose edge it is, under which the
@@ -318,7 +321,8 @@ class PositionPredictor {
   bool alongAxisContext(uint32_t vertex, int level, int& context, bool& mirrored);
   // The bins of the neighbours through edges along the split axis and their
   // centroid's offset in half widths (fast decoding).
-  bool gatherAlongAxis(uint32_t vertex, int level, Neighbourhood& around, double& centroid);
+  [[gnu::always_inline]] inline bool gatherAlongAxis(uint32_t vertex, int level, AlongAxisBins& bins,
+                                                     double& centroid);
   CountContext alongAxisCountContext(uint32_t vertex, int level);
   // The refinement class without far halves, by centroid bucket.
   static constexpr int kAlongAxisCentroidBuckets = 4;
@@ -340,7 +344,7 @@ class PositionPredictor {
   // two, so multiplying by it rounds exactly as dividing by the half width
   // would, without a division's latency.
   std::vector<double> inverseHalfWidths_;
-  LargeArray<Place> places_;
+  LargeArray<double> centres_;
   LargeArray<uint32_t> proxies_;  // per vertex in no simplex, else kNoSimplex
   const SimplexStore& store_;
   // Per triangle slot (see searchAcross()), the slot of the far vertex c of the
