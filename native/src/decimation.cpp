@@ -281,7 +281,7 @@ void decimate(SimplexStore& store, const std::vector<VertexSplitIds>& splits,
     int n = 0;
     for (int i = 0; i <= d; ++i)
       if (v[i] != skip && v[i] != skipToo) out[n++] = v[i];
-    std::sort(out, out + n);
+    sortFewVertices(out, n);
   };
   records.bytes.clear();
   // Merges are recorded last split first, into `reversed`; each split's
@@ -309,7 +309,7 @@ void decimate(SimplexStore& store, const std::vector<VertexSplitIds>& splits,
         const uint32_t* sv = store.vertices(d, s);
         const bool meaningful = store.flags(d, s) & SimplexStore::kMeaningful;
         const uint8_t target = d >= 2 && meaningful ? split_record::target(store.parity(d, s)) : 0;
-        if (std::find(sv, sv + d + 1, v1) != sv + d + 1) {
+        if (containsVertex(sv, d + 1, v1)) {
           // S = S' ∪ {v1, v2}: the decoder makes it by coding S' as 4.
           if (d >= 2) {
             uint32_t faceOthers[3];

@@ -36,6 +36,14 @@ inline int tupleParity(const uint32_t* v, int n) {
   return inversions & 1;
 }
 
+// Whether vertex is one of vertices[0..arity): a plain loop, without a
+// branch per id (std::find over at most four ids was an out-of-line call).
+inline bool containsVertex(const uint32_t* vertices, int arity, uint32_t vertex) {
+  bool found = false;
+  for (int i = 0; i < arity; ++i) found |= vertices[i] == vertex;
+  return found;
+}
+
 // Sorts the n ≤ 4 vertex ids v[0..n) ascending by a network of minima and
 // maxima: no branch on the ids, whose order is a coin toss for the branch
 // predictor.

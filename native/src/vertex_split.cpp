@@ -14,14 +14,6 @@ bool lessOthers(const uint32_t* a, const uint32_t* b, int count) {
   return false;
 }
 
-// A plain loop: std::find over at most four ids was an out-of-line call in
-// the orientation vote, the decoder's third hottest loop.
-bool containsVertex(const uint32_t* vertices, int arity, uint32_t vertex) {
-  bool found = false;
-  for (int i = 0; i < arity; ++i) found |= vertices[i] == vertex;
-  return found;
-}
-
 // Number of vertices of the simplex with a smaller id than `vertex`: the
 // position `vertex` would take in the ascending tuple.
 int rankOf(const uint32_t* vertices, int arity, uint32_t vertex) {
