@@ -10,8 +10,8 @@ export const EXTENSION_NAME: 'KDMESH_progressive_compression';
 export interface KDMeshGLTFOptions {
   /** Decodes the streams in its pool of workers (default: one loader shared by every plugin without one). */
   loader?: KDMeshLoader;
-  /** After each refinement of a compressed primitive's geometry. */
-  onRefine?: (geometry: BufferGeometry, stats: LoadStats) => void;
+  /** After each refinement of a compressed primitive's geometry; a promise it returns holds that primitive's next refinement back until it settles. */
+  onRefine?: (geometry: BufferGeometry, stats: LoadStats) => unknown;
   /** Aborting stops every stream at its current level. */
   signal?: AbortSignal;
   limits?: DecoderLimits;

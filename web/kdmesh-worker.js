@@ -10,7 +10,8 @@
 // Messages in:  {type: 'start', wasm (a WebAssembly.Module), limits?, coarsePlacement?, tetrahedra?, geomorph?,
 //               normals? (false: compute none)}
 //               (a new stream), {type: 'bytes', bytes}, {type: 'end'},
-//               {type: 'next'} (the page is ready for a snapshot)
+//               {type: 'next'} (the page is ready for a snapshot),
+//               {type: 'last'} (the page is ready for the complete model only, for now)
 // Messages out: {type: 'header', header} (with header.labels, see sendHeader()),
 //               {type: 'snapshot', model} (the last one has model.complete),
 //               {type: 'error', code, message}
@@ -194,7 +195,8 @@ function snapshotDue() {
 
 function sendSnapshot() {
   const { decoder, wireframe, geomorph } = job;
-  if (!decoder || !job.wanted || !job.changed || !snapshotDue()) return;
+  if (!decoder || !job.changed) return;
+  if (!(job.wanted && snapshotDue()) && !(job.wantsLast && decoder.progress.complete)) return;
   const began = performance.now();
   const live = decoder.snapshot({ copy: false });  // views, valid until the next call on the decoder
   const { triangles: boundary, owners } = live.tetrahedra.length ? boundaryOfTetrahedra(live.tetrahedra)
@@ -240,7 +242,7 @@ function sendSnapshot() {
     parents: geomorph ? decoder.parents() : new Uint32Array(0),
     progress: decoder.progress,
   };
-  job.wanted = false;
+  job.wanted = job.wantsLast = false;
   job.changed = false;
   job.decodeMs = 0;
   job.handOverMs = performance.now() - began;
@@ -320,7 +322,7 @@ function schedule() {
 
 async function start({ wasm, limits, coarsePlacement, tetrahedra, geomorph, normals }) {
   const current = (job = {
-    decoder: null, done: false, wanted: true, changed: false, pending: [], ending: false, pumping: false,
+    decoder: null, done: false, wanted: true, wantsLast: false, changed: false, pending: [], ending: false, pumping: false,
     header: null, headerSent: false,  // the header as last read, and whether the page has it (see sendHeader())
     labels: null, labelIndex: null,   // the label table, and each label's index in it (see orderByLabel())
     decodeMs: 0, handOverMs: 0,  // decoding since the last snapshot, and that snapshot's cost (snapshotDue())
@@ -358,6 +360,10 @@ onmessage = ({ data }) => {
       break;
     case 'next':
       job.wanted = true;
+      if (job.decoder) sendSnapshot();
+      break;
+    case 'last':
+      job.wantsLast = true;
       if (job.decoder) sendSnapshot();
       break;
   }

@@ -49,7 +49,12 @@ export interface LoadStats {
 }
 
 export interface LoadOptions<T> {
-  onRefine?: (object: T, stats: LoadStats) => void;
+  /**
+   * After each refinement. A promise (thenable) it returns holds the next refinement back until it
+   * settles, while the worker decodes on; the complete model still comes as soon as it is decoded.
+   * A page whose frames are slow to draw can so pace the levels it is handed.
+   */
+  onRefine?: (object: T, stats: LoadStats) => unknown;
   onHeader?: (header: Header) => void;
   onProgress?: (stats: LoadStats, event: ProgressEvent) => void;
   /** Aborting stops the download and keeps the current level. */

@@ -654,7 +654,10 @@ export class KDMeshLoader extends Loader {
 
   /**
    * Starts streaming `url` and returns the group at once. Options: onRefine(model,
-   * stats) after each refinement, onHeader(header), onProgress(stats, event),
+   * stats) after each refinement (a promise it returns holds the next refinement
+   * back until it settles: a page whose frames are slow to draw, say under
+   * software WebGL, can leave the cores to the decoder), onHeader(header),
+   * onProgress(stats, event),
    * signal (AbortSignal: stops the download and keeps the current level),
    * limits (decoder caps, default setDecoderLimits'), coarsePlacement ('predicted', the
    * default, or 'centre': where vertices of unfinished cells are drawn, see kdmesh's
@@ -832,15 +835,22 @@ export class KDMeshLoader extends Loader {
 
     // A snapshot waits for the next frame; an error that arrives meanwhile
     // is reported after it is drawn, so the last good level stays on screen.
+    // A promise from onRefine holds the next level back until it settles:
+    // the worker decodes on meanwhile, and the page draws fewer levels; the
+    // complete model comes as soon as it is decoded all the same.
     let drawing = Promise.resolve();
     const draw = async (model) => {
       if (!(await view.show(model, stopped))) return;
       stats.refinements += 1;
       stats.complete = model.complete;
       stats.model = model;
-      options.onRefine?.(view.object, stats);
-      if (stats.complete) finish();
-      else worker.postMessage({ type: 'next' });
+      const paced = options.onRefine?.(view.object, stats);
+      if (stats.complete) return finish();
+      if (paced && typeof paced.then === 'function') {
+        worker.postMessage({ type: 'last' });
+        await Promise.resolve(paced).then(() => {}, () => {});
+      }
+      if (!finished) worker.postMessage({ type: 'next' });
     };
     const onMessage = ({ data }) => {
       if (finished) return;

@@ -145,6 +145,38 @@ resize();
 // software-rendered page with a large model stays responsive. A frame is
 // drawn only once the GPU has finished the previous one (see GpuFence).
 const previousFrame = new GpuFence(renderer.getContext());
+// While the decoder lags the download, drawing may keep the machine busy
+// for at most this share of the time. Under software WebGL a frame of a
+// large level takes the GPU process a second or more on the cores that the
+// decoding worker needs; so such a level asks for the next one (the
+// loader's onRefine promise) only once the frame that drew it has finished
+// and (1 - share) / share times that frame's time has passed since. On a
+// GPU a frame takes milliseconds, and while the decoder keeps up with the
+// download a frame delays nothing: every level is drawn.
+const kDrawShare = 0.25;
+// The decoder lags when more than this many received bytes wait for it.
+const kLagBytes = 65536;
+let levelsToDraw = [];  // resolvers of levels shown since the last frame began
+function paceRefinements(stats) {
+  if (stats.bytesReceived - stats.model.progress.bytesConsumed <= kLagBytes) return undefined;
+  const drawn = new Promise((resolve) => levelsToDraw.push(resolve));
+  requestRender();
+  return drawn;
+}
+// Resolves `levels` once the frame begun at `began` has finished and
+// drawing has had its share.
+function paceAfterFrame(began, levels) {
+  const fence = new GpuFence(renderer.getContext());
+  fence.set();
+  requestAnimationFrame(function poll() {
+    if (!fence.passed()) {
+      requestAnimationFrame(poll);
+      return;
+    }
+    const frameMs = performance.now() - began;
+    setTimeout(() => levels.forEach((resolve) => resolve()), (frameMs * (1 - kDrawShare)) / kDrawShare);
+  });
+}
 let frameRequested = false;
 function requestRender() {
   if (frameRequested) return;
@@ -158,8 +190,13 @@ function requestRender() {
     paintStatus();
     controls.update();
     fitFog();
+    const began = performance.now();
     renderer.render(scene, camera);
     previousFrame.set();
+    if (levelsToDraw.length) {
+      paceAfterFrame(began, levelsToDraw);
+      levelsToDraw = [];
+    }
     const elapsed = performance.now() - loadBegan;
     if (viewer.refinements > 0 && viewer.firstRenderMs === null) viewer.firstRenderMs = elapsed;
     if (viewer.state === 'complete' && viewer.finalRenderMs === null) viewer.finalRenderMs = elapsed;
@@ -346,6 +383,7 @@ function start(load) {
         decoded: viewer.vertexTotal ? m.vertexCount / viewer.vertexTotal : 0,
         ...(m.complete ? { downloaded: 1 } : {}),
       });
+      return paceRefinements(stats);
     },
   };
   group = current = load(options);
@@ -393,7 +431,14 @@ function loadScene(url, options) {
     queueStatus(describeScene(group), { decoded: viewer.streams ? viewer.streamsComplete / viewer.streams : 1 });
   };
   const gltfLoader = new GLTFLoader().register((parser) =>
-    new KDMeshGLTFExtension(parser, { loader, signal: options.signal, onRefine: (geometry, s) => options.isCurrent() && refined(geometry, s) }));
+    new KDMeshGLTFExtension(parser, {
+      loader, signal: options.signal,
+      onRefine: (geometry, s) => {
+        if (!options.isCurrent()) return undefined;
+        refined(geometry, s);
+        return paceRefinements(s);
+      },
+    }));
   const loaded = gltfLoader.loadAsync(url, (event) => options.onProgress({ bytesReceived: event.loaded, bytesExpected: event.total }))
     .then(async (gltf) => {
       group.add(gltf.scene);

@@ -1,7 +1,8 @@
 // KDMeshLoader in headless chromium, as a three.js application uses it:
 // LoadingManager events and URL handling, abort(), dispose() mid-load, the
-// worker pool's limit, the BufferGeometry result, decoder limits, a
-// WebAssembly file that cannot be fetched, vertex attributes and simplex labels. Models come from the viewer's
+// worker pool's limit, the BufferGeometry result, refinements paced by the
+// page, decoder limits, a WebAssembly file that cannot be fetched, vertex
+// attributes and simplex labels. Models come from the viewer's
 // dev server, paced where a load must still be running.
 import { test, before, after } from 'node:test';
 import assert from 'node:assert/strict';
@@ -194,6 +195,44 @@ test('loadGeometry refines one BufferGeometry in place and ends on the model', a
   assert.ok(result.normalError < 1e-5, `largest normal difference ${result.normalError}`);
   assert.ok(result.radius > 0);
   assert.equal(result.checksum, expected.checksum);
+  assert.deepEqual(errors, []);
+  await page.close();
+});
+
+test('a promise from onRefine holds the next level back; the complete model comes when decoded', async () => {
+  const { page, errors } = await openPage();
+  const result = await page.evaluate(async () => {
+    const loader = new KDMeshLoader();
+    // Paced over two seconds or so, a level about every chunk of the
+    // stream: each level holds the next back for 400 ms, or for good.
+    const load = async (hold) => {
+      const levels = [];
+      let holding = false;
+      const model = loader.loadProgressive('models/fandisk.kdm?throttle=40', {
+        onRefine(object, stats) {
+          levels.push({ complete: stats.complete, duringHold: holding });
+          if (stats.complete) return undefined;
+          holding = true;
+          return hold === Infinity ? new Promise(() => {})
+            : new Promise((resolve) => setTimeout(() => { holding = false; resolve(); }, hold));
+        },
+      });
+      await model.userData.loaded;
+      return { levels, checksum: modelChecksum(model.userData.stats.model) };
+    };
+    const paced = await load(400);
+    const heldForGood = await load(Infinity);
+    loader.dispose();
+    return { paced, heldForGood };
+  });
+  const { paced, heldForGood } = result;
+  assert.ok(paced.levels.length >= 2, JSON.stringify(paced.levels));
+  assert.deepEqual(paced.levels.filter((level) => !level.complete && level.duringHold), []);
+  assert.equal(paced.levels.at(-1).complete, true);
+  assert.equal(paced.checksum, expected.checksum);
+  // The first level holds every later one back, but not the complete model.
+  assert.deepEqual(heldForGood.levels, [{ complete: false, duringHold: false }, { complete: true, duringHold: true }]);
+  assert.equal(heldForGood.checksum, expected.checksum);
   assert.deepEqual(errors, []);
   await page.close();
 });

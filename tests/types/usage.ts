@@ -72,6 +72,7 @@ export async function loading(renderer: WebGLRenderer): Promise<BufferGeometry> 
   loader.load('c.kdm', (g: Group) => scene.add(g), (event: ProgressEvent) => event.total, (error: unknown) => String(error));
   loader.parse(new ArrayBuffer(10), (g: Group) => g.children.length);
   const geometry = loader.loadGeometry('d.kdm', { onRefine: (g: BufferGeometry) => g.drawRange.count });
+  loader.loadGeometry('e.kdm', { onRefine: () => new Promise<void>((resolve) => setTimeout(resolve, 100)) });
   scene.add(new Mesh(geometry, new MeshNormalMaterial()));
   const primitive: 'triangles' | 'lines' | 'points' | undefined = geometry.userData.primitive;
   await geometry.userData.loaded;
