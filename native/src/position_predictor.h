@@ -283,8 +283,8 @@ class PositionPredictor {
   // `farHalves` (whether the far halves of the slabs beside the cell hold
   // a neighbour already split). Counts the predictions with a neighbour
   // split in the cell's slab.
-  // Inlined always: on the fast path it is a few dozen instructions per
-  // one-vertex decision, and a call's share of them.
+  // Inlined always: the fast path takes it at every one-vertex decision,
+  // where a call would add much to its few dozen instructions.
   [[gnu::always_inline]] inline int refinementClass(const AlongAxisBins& bins, bool mirrored, bool farHalves);
   // Searches the triangle b a c across the edge a b (wound a b) and
   // returns the slot of its vertex c, or kNowhere; `slot` (triangle · 3 +

@@ -661,6 +661,8 @@ int VertexSplitter::neighbourVote(uint32_t simplex, int myParity, uint32_t other
   return mySign == theirSign ? 1 : -1;
 }
 
+// The candidates' votes: flip when more vote to flip than to keep;
+// voteClass 0 without a vote, 1 when all agree, 2 when they differ.
 template <int kArity>
 int VertexSplitter::voteOnFlip(uint32_t simplex, const std::vector<uint32_t>& candidates, int& voteClass) {
   constexpr int kDimension = kArity - 1;
