@@ -275,8 +275,9 @@ void decimate(SimplexStore& store, const std::vector<VertexSplitIds>& splits,
     const StarEntry* entry = findInStar(starOfKept, beginOfKept, dimension, others);
     return entry ? entry->simplex : kNoSimplex;
   };
-  // The vertices of a simplex but `skip` and `skipToo`, ascending.
-  auto othersBut = [&store](int d, uint32_t simplex, uint32_t skip, uint32_t skipToo, uint32_t (&out)[3]) {
+  // The vertices of a simplex but `skip` and `skipToo`, ascending (at most
+  // three; `out` has room for the four that sortFewVertices() can order).
+  auto othersBut = [&store](int d, uint32_t simplex, uint32_t skip, uint32_t skipToo, uint32_t (&out)[4]) {
     const uint32_t* v = store.vertices(d, simplex);
     int n = 0;
     for (int i = 0; i <= d; ++i)
@@ -312,7 +313,7 @@ void decimate(SimplexStore& store, const std::vector<VertexSplitIds>& splits,
         if (containsVertex(sv, d + 1, v1)) {
           // S = S' ∪ {v1, v2}: the decoder makes it by coding S' as 4.
           if (d >= 2) {
-            uint32_t faceOthers[3];
+            uint32_t faceOthers[4];
             othersBut(d, s, v1, v2, faceOthers);
             const uint32_t parent = findAroundKept(d - 1, faceOthers);
             scratch[size_t(d - 1)][parent] |=
@@ -327,7 +328,7 @@ void decimate(SimplexStore& store, const std::vector<VertexSplitIds>& splits,
           store.kill(d, s);
           continue;
         }
-        uint32_t twinOthers[3];
+        uint32_t twinOthers[4];
         othersBut(d, s, v2, v2, twinOthers);
         const uint32_t twin = findAroundKept(d, twinOthers);
         if (twin == kNoSimplex) {

@@ -625,11 +625,11 @@ bool VertexSplitter::isFaceOfHigher(int dimension, uint32_t simplex) {
 // first two ids in one word, the third, or 0, in the other.
 VertexSplitter::FacetKey VertexSplitter::facetKey(int dimension, uint32_t simplex, int skip) const {
   const uint32_t* v = store_.vertices(dimension, simplex);
-  uint32_t facet[3] = {0, 0, 0};
+  uint32_t facet[4] = {0, 0, 0, 0};  // room for the four sortFewVertices() can order
   int n = 0;
   for (int i = 0; i <= dimension; ++i)
     if (i != skip) facet[n++] = v[i];
-  std::sort(facet, facet + n);
+  sortFewVertices(facet, n);
   return {uint64_t(facet[0]) << 32 | facet[1], facet[2]};
 }
 
