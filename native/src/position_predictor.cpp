@@ -92,16 +92,20 @@ int spreadClass(double spread) {
 // Offsets are exact (multiples of 1/4 grid steps) and twice one is an
 // integer q = 4 · slab + side of magnitude below 2^33; the three slabs
 // are q = −5..6 (q = 4 · slab + 2, half a width off the grid, does not
-// arise; it counts in the lower slab, not split), looked up in a table.
+// arise; it counts in the lower slab, not split), looked up in a table
+// whose last entry, bin 9, takes every other q. Clamping the index instead
+// of testing it keeps the lookup free of a branch: whether a neighbour is
+// far is a coin toss for the branch predictor.
 namespace {
 struct AlongBins {
-  int8_t bins[12] = {};
+  int8_t bins[13] = {};
   constexpr AlongBins() {
     constexpr int kSide[4] = {0, 1, 0, -1};  // by q mod 4
     for (int q = -5; q <= 6; ++q) {
       const int slab = (q + 1 + 8) / 4 - 2;  // floor((q + 1) / 4)
       bins[q + 5] = int8_t(3 * (slab + 1) + kSide[(q + 8) % 4] + 1);
     }
+    bins[12] = 9;
   }
 };
 constexpr AlongBins kAlongBins{};
@@ -109,7 +113,7 @@ constexpr AlongBins kAlongBins{};
 
 int alongBin(double offset) {
   const uint64_t index = uint64_t(int64_t(offset * 2) + 5);
-  return index < 12 ? kAlongBins.bins[index] : 9;
+  return kAlongBins.bins[std::min<uint64_t>(index, 12)];
 }
 
 namespace {
@@ -491,8 +495,8 @@ int PositionPredictor::refinementClass(const AlongAxisBins& bins, bool mirrored,
     if (farHalves) c = c * 4 + pair(8, 0);
     return c;
   };
-  const uint32_t upward = classFrom(0, 1), downward = classFrom(8, -1);
-  return int(mirrored ? downward : upward);
+  const uint32_t readings[2] = {classFrom(0, 1), classFrom(8, -1)};
+  return int(readings[mirrored]);
 }
 
 bool PositionPredictor::contextsOf(uint32_t vertex, int level, SingleContexts& c) {
@@ -559,7 +563,7 @@ bool PositionPredictor::alongAxisContext(uint32_t vertex, int level, int& contex
   ++positionPredictions_;
   mirrored = centroid < 0;
   const double offset = std::fabs(centroid);
-  const int bucket = offset < 0.25 ? 0 : offset < 0.75 ? 1 : offset < 1.5 ? 2 : 3;
+  const int bucket = int(offset >= 0.25) + int(offset >= 0.75) + int(offset >= 1.5);
   context = refinementClass(bins, mirrored, false) * kAlongAxisCentroidBuckets + bucket;
   return true;
 }
@@ -573,7 +577,7 @@ CountContext PositionPredictor::alongAxisCountContext(uint32_t vertex, int level
   CountContext context;
   context.mirrored = centroid < 0;
   const double offset = std::fabs(centroid);
-  context.neighbourhoodClass = offset < 0.5 ? 10 : offset < 1.5 ? 11 : 12;
+  context.neighbourhoodClass = 10 + int(offset >= 0.5) + int(offset >= 1.5);
   context.refinement = refinementClass(bins, context.mirrored, false);
   return context;
 }

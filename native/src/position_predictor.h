@@ -158,7 +158,7 @@ class PositionPredictor {
     // The half's centre lies a quarter of the cell's width below or above.
     const int axis = axis_[size_t(level)];
     const double quarter = widths_[size_t(level)][size_t(axis)] * 0.25;
-    centre(vertex)[axis] += first ? -quarter : quarter;
+    centre(vertex)[axis] += double(1 - 2 * int(first)) * quarter;
     return first;
   }
 

@@ -13,6 +13,7 @@
 #include <cstdint>
 #include <vector>
 
+
 namespace kdmesh {
 
 constexpr int kProbabilityBits = 15;
@@ -38,14 +39,16 @@ struct BitModel {
     const int slowShift = kSlowShift[std::min<int>(seen, 64) >> 3];
     seen = uint16_t(seen + (seen < 0xffff));
     // Keep the slow estimate away from 0 and 1 so every symbol stays
-    // codable; a step towards one bound cannot cross the other.
-    if (bit) {
-      fast = uint16_t(fast - (fast >> 4));
-      slow = uint16_t(std::max<int>(slow - (slow >> slowShift), 31));
-    } else {
-      fast = uint16_t(fast + ((kProbabilityOne - fast) >> 4));
-      slow = uint16_t(std::min<int>(slow + ((kProbabilityOne - slow) >> slowShift), kProbabilityOne - 31));
-    }
+    // codable; a step towards one bound cannot cross the other. Both steps
+    // are computed and one kept: the bit is a coin toss for the branch
+    // predictor.
+    const uint16_t fastIfOne = uint16_t(fast - (fast >> 4));
+    const uint16_t fastIfZero = uint16_t(fast + ((kProbabilityOne - fast) >> 4));
+    const uint16_t slowIfOne = uint16_t(std::max<int>(slow - (slow >> slowShift), 31));
+    const uint16_t slowIfZero =
+        uint16_t(std::min<int>(slow + ((kProbabilityOne - slow) >> slowShift), kProbabilityOne - 31));
+    fast = bit ? fastIfOne : fastIfZero;
+    slow = bit ? slowIfOne : slowIfZero;
   }
 };
 
@@ -201,15 +204,11 @@ class RangeDecoder {
 
   [[gnu::always_inline]] bool bitWithProbability(uint32_t p0, bool /*unused*/ = false) {
     const uint32_t bound = (range_ >> kProbabilityBits) * p0;
-    bool value;
-    if (code_ < bound) {
-      range_ = bound;
-      value = false;
-    } else {
-      code_ -= bound;
-      range_ -= bound;
-      value = true;
-    }
+    // A 1 takes [bound, range) and moves the code down by bound, a 0 keeps
+    // [0, bound); selected, as the bit is hard to predict.
+    const bool value = code_ >= bound;
+    code_ -= value ? bound : 0u;
+    range_ = value ? range_ - bound : bound;
     if (measuring_) cost_ += CostTable::bits(value ? kProbabilityOne - p0 : p0);
     normalize();
     return value;

@@ -54,11 +54,6 @@ void SimplexStore::kill(int dimension, uint32_t simplex) {
   --live_[dimension];
 }
 
-void SimplexStore::replaceVertex(int dimension, uint32_t simplex, uint32_t from, uint32_t to) {
-  uint32_t* v = &pool_[dimension].vertices[size_t(simplex) * size_t(dimension + 1)];
-  for (int i = 0; i <= dimension; ++i) v[i] = v[i] == from ? to : v[i];  // no branch to mispredict
-}
-
 bool SimplexStore::hasIncident(int dimension, uint32_t vertex) const {
   return forEachIncident(dimension, vertex, [](uint32_t, uint32_t) { return true; });
 }

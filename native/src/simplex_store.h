@@ -49,9 +49,9 @@ inline bool containsVertex(const uint32_t* vertices, int arity, uint32_t vertex)
 // predictor.
 inline void sortFewVertices(uint32_t* v, int n) {
   auto order = [v](int a, int b) {
-    const uint32_t low = std::min(v[a], v[b]);
-    v[b] = std::max(v[a], v[b]);
-    v[a] = low;
+    const uint32_t x = v[a], y = v[b];
+    v[a] = std::min(x, y);
+    v[b] = std::max(x, y);
   };
   if (n == 2) {
     order(0, 1);
@@ -98,7 +98,10 @@ class SimplexStore {
   // Replaces vertex `from` of a simplex by `to` (which it must not contain),
   // keeping the orientation. Lists are left alone: the split and merge
   // routines detach and relink the two vertices' lists themselves.
-  void replaceVertex(int dimension, uint32_t simplex, uint32_t from, uint32_t to);
+  void replaceVertex(int dimension, uint32_t simplex, uint32_t from, uint32_t to) {
+    uint32_t* v = &pool_[dimension].vertices[size_t(simplex) * size_t(dimension + 1)];
+    for (int i = 0; i <= dimension; ++i) v[i] = v[i] == from ? to : v[i];  // no branch to mispredict
+  }
 
   const uint32_t* vertices(int dimension, uint32_t simplex) const {
     return &pool_[dimension].vertices[size_t(simplex) * size_t(dimension + 1)];

@@ -78,9 +78,15 @@ void gatherStar(SimplexStore& store, uint32_t v, std::vector<StarEntry>& star,
       entry.dimension = uint8_t(d);
       entry.position = uint8_t(position);
       const uint32_t* vertices = store.vertices(d, simplex);
+      // Every vertex is written and the count advanced past all but v's:
+      // no branch on where v lies in the tuple.
+      uint32_t others[4];
       int n = 0;
-      for (int i = 0; i <= d; ++i)
-        if (i != int(position)) entry.others[n++] = vertices[i];
+      for (int i = 0; i <= d; ++i) {
+        others[n] = vertices[i];
+        n += i != int(position);
+      }
+      std::copy_n(others, 3, entry.others);
       sortFewVertices(entry.others, n);
       star.push_back(entry);
     });
@@ -315,15 +321,15 @@ void VertexSplitter::linkFans() {
     star_[i].links[0] = star_[i].links[1] = kNoSimplex;
   }
   crowdedLinks_ = 0;
+  // Fills the first free link, or counts the edge as crowded; selects, not
+  // branches, as which link is free varies from edge to edge.
   auto link = [this](uint32_t from, uint32_t to) {
     uint32_t* links = star_[from].links;
-    if (links[0] == kNoSimplex) {
-      links[0] = to;
-    } else if (links[1] == kNoSimplex) {
-      links[1] = to;
-    } else {
-      ++crowdedLinks_;
-    }
+    const bool firstFree = links[0] == kNoSimplex;
+    const bool secondFree = !firstFree & (links[1] == kNoSimplex);
+    links[0] = firstFree ? to : links[0];
+    links[1] = secondFree ? to : links[1];
+    crowdedLinks_ += !firstFree & !secondFree;
   };
   // A triangle's edges through v are found by their other vertex in
   // edgeTo_, which each split fills for its own edges: an entry left by an
@@ -377,11 +383,15 @@ void VertexSplitter::indexFan() {
   for (size_t i = first; i < last; ++i)
     if (star_[i].links[1] == kNoSimplex) return;
   fanOrder_.clear();
-  uint32_t previous = kNoSimplex, at = uint32_t(first);
+  // Links are mutual (linkFans() made each both ways, none dropped), so
+  // the edge the walk came from is one of the two links and the next is
+  // the other: their exclusive or without the previous one. Starting as
+  // if from links[1] walks on to links[0].
+  uint32_t previous = star_[first].links[1], at = uint32_t(first);
   do {
     star_[at].fanIndex = uint8_t(fanOrder_.size());
     fanOrder_.push_back(at);
-    const uint32_t next = star_[at].links[0] != previous ? star_[at].links[0] : star_[at].links[1];
+    const uint32_t next = star_[at].links[0] ^ star_[at].links[1] ^ previous;
     previous = at;
     at = next;
   } while (at != first && fanOrder_.size() <= last - first);

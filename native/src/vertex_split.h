@@ -622,7 +622,8 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int
   for (size_t i = 1; i < star_.size(); ++i) {
     Entry& entry = star_[i];
     const int d = entry.dimension;
-    if (entry.code == 2) store_.replaceVertex(d, entry.simplex, v, v2);
+    // v stays v unless the code sends the simplex to v2: no branch on the code.
+    store_.replaceVertex(d, entry.simplex, v, entry.code == 2 ? v2 : v);
     if (d == 2) geometry_.forgetAcross(entry.simplex, entry.position);
     store_.link(d, entry.simplex, entry.position);
     if (entry.code < 3) continue;
