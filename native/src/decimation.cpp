@@ -334,7 +334,7 @@ void decimate(SimplexStore& store, const std::vector<VertexSplitIds>& splits,
         if (twin == kNoSimplex) {
           // Only v2 has it: code 2.
           const uint32_t position = uint32_t(std::find(sv, sv + d + 1, v2) - sv);
-          store.replaceVertex(d, s, v2, v1);
+          store.setVertex(d, s, position, v1);
           store.link(d, s, position);
           scratch[size_t(d)][s] = 1;
           continue;

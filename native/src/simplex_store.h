@@ -95,12 +95,12 @@ class SimplexStore {
   uint32_t add(int dimension, const uint32_t* vertices, uint8_t flags, uint32_t label = kNoLabel);
   // Killable stores only.
   void kill(int dimension, uint32_t simplex);
-  // Replaces vertex `from` of a simplex by `to` (which it must not contain),
-  // keeping the orientation. Lists are left alone: the split and merge
-  // routines detach and relink the two vertices' lists themselves.
-  void replaceVertex(int dimension, uint32_t simplex, uint32_t from, uint32_t to) {
-    uint32_t* v = &pool_[dimension].vertices[size_t(simplex) * size_t(dimension + 1)];
-    for (int i = 0; i <= dimension; ++i) v[i] = v[i] == from ? to : v[i];  // no branch to mispredict
+  // Puts `vertex` at `position` of a simplex's tuple (which must not
+  // contain it elsewhere), keeping the orientation. Lists are left alone:
+  // the split and merge routines detach and relink the vertices' lists
+  // themselves.
+  void setVertex(int dimension, uint32_t simplex, uint32_t position, uint32_t vertex) {
+    pool_[dimension].vertices[size_t(simplex) * size_t(dimension + 1) + position] = vertex;
   }
 
   const uint32_t* vertices(int dimension, uint32_t simplex) const {

@@ -406,7 +406,7 @@ int VertexSplitter::cutBand(int position, int cut) const {
 
 int VertexSplitter::fanSlot(const Entry& triangle) const {
   const int a = star_[triangle.links[0]].fanIndex, b = star_[triangle.links[1]].fanIndex;
-  return (a + 1) % fanSize_ == b ? a : b;
+  return (a + 1 == fanSize_ ? 0 : a + 1) == b ? a : b;
 }
 
 // The star is one closed fan (closedFanStar()): its records make an edge
@@ -485,9 +485,11 @@ int VertexSplitter::runClass(const Entry& edge, int cutEdges, bool mirrored) {
   auto endOf = [&](int step, int& distance) {
     int at = edge.fanIndex;
     for (distance = 1; distance < fanSize_; ++distance) {
-      at = (at + step + fanSize_) % fanSize_;
+      at += step;  // around the fan, wrapping without a division
+      at += at < 0 ? fanSize_ : 0;
+      at -= at >= fanSize_ ? fanSize_ : 0;
       const uint8_t code = star_[fanOrder_[size_t(at)]].code;
-      if (code != 0) return code >= 3 ? 2 : code - 1;
+      if (code != 0) return std::min(code - 1, 2);
     }
     return -1;
   };

@@ -522,14 +522,15 @@ void VertexSplitter::codeFanExpansion(Coder& coder) {
   };
   int cuts = 0, firstCut = -1;
   uint8_t side;  // of the arc the walk is in
-  const int next = (start + 1) % n;
+  auto following = [n](int k) { return k + 1 == n ? 0 : k + 1; };  // around the fan, no division
+  const int next = following(start);
   if (coder.bit(startCutModels_[bucketAt(start)], recorded(start) == 4)) {
     cuts = 1;
     firstCut = start;
     give(start, 4);
     // The arc after the cut: the next edge's side, or, when that is the
     // other cut, the opposite of the edge after it.
-    const uint8_t arc = recorded(next) != 4 ? recorded(next) : uint8_t(3 - recorded((next + 1) % n));
+    const uint8_t arc = recorded(next) != 4 ? recorded(next) : uint8_t(3 - recorded(following(next)));
     side = uint8_t(coder.bit(arcSideModel_, arc != sideAt(next)) ? 3 - sideAt(next) : sideAt(next));
   } else {
     side = uint8_t(coder.bit(startSideModels_[bucketAt(start)], recorded(start) != sideAt(start)) ? 3 - sideAt(start)
@@ -537,8 +538,8 @@ void VertexSplitter::codeFanExpansion(Coder& coder) {
     give(start, side);
   }
   slotSides_[size_t(start)] = side;
-  for (int step = 1; step < n; ++step) {
-    const int k = (start + step) % n, after = (k + 1) % n;
+  for (int step = 1, k = next; step < n; ++step, k = following(k)) {
+    const int after = following(k);
     const int left = n - step;  // edges left, this one included
     bool cut = false;
     if ((cuts == 0 && left == 2) || (cuts == 1 && left == 1)) {
@@ -623,7 +624,7 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int
     Entry& entry = star_[i];
     const int d = entry.dimension;
     // v stays v unless the code sends the simplex to v2: no branch on the code.
-    store_.replaceVertex(d, entry.simplex, v, entry.code == 2 ? v2 : v);
+    store_.setVertex(d, entry.simplex, entry.position, entry.code == 2 ? v2 : v);
     if (d == 2) geometry_.forgetAcross(entry.simplex, entry.position);
     store_.link(d, entry.simplex, entry.position);
     if (entry.code < 3) continue;

@@ -73,9 +73,9 @@ TEST(SimplexStore, WalksListTheLiveSimplicesThroughKills) {
   }
 }
 
-// A replaced vertex changes the tuple in place, orientation kept; lists are
+// A vertex set in a tuple changes it in place, orientation kept; lists are
 // the caller's to relink.
-TEST(SimplexStore, ReplaceVertexKeepsTheOrientation) {
+TEST(SimplexStore, SetVertexKeepsTheOrientation) {
   SimplexStore store;
   store.reset(8, true);
   const uint32_t a[3] = {0, 1, 2}, b[3] = {0, 2, 3};
@@ -83,7 +83,7 @@ TEST(SimplexStore, ReplaceVertexKeepsTheOrientation) {
   const uint32_t second = store.add(2, b, SimplexStore::kFlipped);
   const int parity = store.parity(2, second);
   store.kill(2, first);
-  store.replaceVertex(2, second, 3, 5);
+  store.setVertex(2, second, 2, 5);  // 3 is at position 2 of 0 2 3
   EXPECT_EQ(sortedVertices(store, 2, second), (VertexSet{0, 2, 5}));
   EXPECT_EQ(store.parity(2, second), parity);  // 0 2 3 and 0 2 5: same rank order
   std::vector<uint32_t> around;
