@@ -313,11 +313,19 @@ function pump(current) {
   if (pending.length || job.ending) schedule();
 }
 
+// Each piece is decoded in a task of its own, posted through a message
+// channel: a chain of setTimeout(0) calls is clamped to at least 4 ms a
+// call after the fifth, idle time that a stream of many pieces would pay
+// between every two. Each message pumps the job that posted it, in
+// posting order.
+const pieces = new MessageChannel();
+const pumped = [];
+pieces.port1.onmessage = () => pump(pumped.shift());
 function schedule() {
   if (job.pumping || !job.decoder) return;
   job.pumping = true;
-  const current = job;
-  setTimeout(() => pump(current), 0);
+  pumped.push(job);
+  pieces.port2.postMessage(null);
 }
 
 async function start({ wasm, limits, coarsePlacement, tetrahedra, geomorph, normals }) {
