@@ -316,7 +316,7 @@ function pump(current) {
 // Each piece is decoded in a task of its own, posted through a message
 // channel: a chain of setTimeout(0) calls is clamped to at least 4 ms a
 // call after the fifth, idle time that a stream of many pieces would pay
-// between every two. Each message pumps the job that posted it, in
+// at nearly every piece. Each message pumps the job that posted it, in
 // posting order.
 const pieces = new MessageChannel();
 const pumped = [];

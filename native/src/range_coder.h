@@ -13,7 +13,6 @@
 #include <cstdint>
 #include <vector>
 
-
 namespace kdmesh {
 
 constexpr int kProbabilityBits = 15;
@@ -40,8 +39,7 @@ struct BitModel {
     seen = uint16_t(seen + (seen < 0xffff));
     // Keep the slow estimate away from 0 and 1 so every symbol stays
     // codable; a step towards one bound cannot cross the other. Both steps
-    // are computed and one kept: the bit is a coin toss for the branch
-    // predictor.
+    // are computed and one kept: the bit is a coin toss for a branch.
     const uint16_t fastIfOne = uint16_t(fast - (fast >> 4));
     const uint16_t fastIfZero = uint16_t(fast + ((kProbabilityOne - fast) >> 4));
     const uint16_t slowIfOne = uint16_t(std::max<int>(slow - (slow >> slowShift), 31));
@@ -205,7 +203,7 @@ class RangeDecoder {
   [[gnu::always_inline]] bool bitWithProbability(uint32_t p0, bool /*unused*/ = false) {
     const uint32_t bound = (range_ >> kProbabilityBits) * p0;
     // A 1 takes [bound, range) and moves the code down by bound, a 0 keeps
-    // [0, bound); selected, as the bit is hard to predict.
+    // [0, bound); written as selects, as the bit is hard to predict.
     const bool value = code_ >= bound;
     code_ -= value ? bound : 0u;
     range_ = value ? range_ - bound : bound;

@@ -321,8 +321,8 @@ void VertexSplitter::linkFans() {
     star_[i].links[0] = star_[i].links[1] = kNoSimplex;
   }
   crowdedLinks_ = 0;
-  // Fills the first free link, or counts the edge as crowded; selects, not
-  // branches, as which link is free varies from edge to edge.
+  // Fills the first free link, or counts the edge as crowded; written as
+  // selects, as which link is free varies from edge to edge.
   auto link = [this](uint32_t from, uint32_t to) {
     uint32_t* links = star_[from].links;
     const bool firstFree = links[0] == kNoSimplex;
@@ -406,7 +406,7 @@ int VertexSplitter::cutBand(int position, int cut) const {
 
 int VertexSplitter::fanSlot(const Entry& triangle) const {
   const int a = star_[triangle.links[0]].fanIndex, b = star_[triangle.links[1]].fanIndex;
-  return (a + 1 == fanSize_ ? 0 : a + 1) == b ? a : b;
+  return fanNext(a) == b ? a : b;
 }
 
 // The star is one closed fan (closedFanStar()): its records make an edge
@@ -485,9 +485,7 @@ int VertexSplitter::runClass(const Entry& edge, int cutEdges, bool mirrored) {
   auto endOf = [&](int step, int& distance) {
     int at = edge.fanIndex;
     for (distance = 1; distance < fanSize_; ++distance) {
-      at += step;  // around the fan, wrapping without a division
-      at += at < 0 ? fanSize_ : 0;
-      at -= at >= fanSize_ ? fanSize_ : 0;
+      at = step > 0 ? fanNext(at) : fanPrevious(at);
       const uint8_t code = star_[fanOrder_[size_t(at)]].code;
       if (code != 0) return std::min(code - 1, 2);
     }
@@ -512,7 +510,7 @@ int VertexSplitter::runClass(const Entry& edge, int cutEdges, bool mirrored) {
     // gains an edge, and meshes keep valences even: the one with fewer
     // edges is the likelier cut.
     const bool besideOne = (before == 1 ? a : b) == 0;
-    const uint32_t other = fanOrder_[size_t((edge.fanIndex + (before == 1 ? 1 : -1) + fanSize_) % fanSize_)];
+    const uint32_t other = fanOrder_[size_t(before == 1 ? fanNext(edge.fanIndex) : fanPrevious(edge.fanIndex))];
     const size_t e = size_t(&edge - star_.data()) - begin_[1], o = size_t(other) - begin_[1];
     const double alongE = cosines_[e] * lengths_[e], alongO = cosines_[o] * lengths_[o];
     const double preference = lengths_[e] * lengths_[e] - lengths_[o] * lengths_[o] +
@@ -739,7 +737,7 @@ int VertexSplitter::predictFlip(int dimension, uint32_t simplex, const Entry& fr
   // that stays at v, the one of its two neighbours on the fan whose arc
   // went to v.
   if (fanExpansionCoded_) {
-    const int before = (from.fanIndex == 0 ? fanSize_ : from.fanIndex) - 1;
+    const int before = fanPrevious(from.fanIndex);
     const int slot = slotSides_[size_t(before)] == 1 ? before : from.fanIndex;
     const int vote = neighbourVote<3>(simplex, store_.parity(2, simplex), star_[slotTriangles_[size_t(slot)]].simplex);
     voteClass = vote != 0;

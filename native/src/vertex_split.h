@@ -224,6 +224,10 @@ class VertexSplitter {
   // `cut`, the shorter way round, against half the fan: 4 for half or
   // more, 3 and 2 for one and two less, else 1.
   int cutBand(int position, int cut) const;
+  // The fan positions after and before `position` around the closed fan
+  // (a compare, not a division).
+  int fanNext(int position) const { return position + 1 == fanSize_ ? 0 : position + 1; }
+  int fanPrevious(int position) const { return (position == 0 ? fanSize_ : position) - 1; }
   // Codes every entry of the star one by one, in the order of orderCodes();
   // false when the codes contradict each other.
   template <class Coder>
@@ -522,15 +526,14 @@ void VertexSplitter::codeFanExpansion(Coder& coder) {
   };
   int cuts = 0, firstCut = -1;
   uint8_t side;  // of the arc the walk is in
-  auto following = [n](int k) { return k + 1 == n ? 0 : k + 1; };  // around the fan, no division
-  const int next = following(start);
+  const int next = fanNext(start);
   if (coder.bit(startCutModels_[bucketAt(start)], recorded(start) == 4)) {
     cuts = 1;
     firstCut = start;
     give(start, 4);
     // The arc after the cut: the next edge's side, or, when that is the
     // other cut, the opposite of the edge after it.
-    const uint8_t arc = recorded(next) != 4 ? recorded(next) : uint8_t(3 - recorded(following(next)));
+    const uint8_t arc = recorded(next) != 4 ? recorded(next) : uint8_t(3 - recorded(fanNext(next)));
     side = uint8_t(coder.bit(arcSideModel_, arc != sideAt(next)) ? 3 - sideAt(next) : sideAt(next));
   } else {
     side = uint8_t(coder.bit(startSideModels_[bucketAt(start)], recorded(start) != sideAt(start)) ? 3 - sideAt(start)
@@ -538,8 +541,8 @@ void VertexSplitter::codeFanExpansion(Coder& coder) {
     give(start, side);
   }
   slotSides_[size_t(start)] = side;
-  for (int step = 1, k = next; step < n; ++step, k = following(k)) {
-    const int after = following(k);
+  for (int step = 1, k = next; step < n; ++step, k = fanNext(k)) {
+    const int after = fanNext(k);
     const int left = n - step;  // edges left, this one included
     bool cut = false;
     if ((cuts == 0 && left == 2) || (cuts == 1 && left == 1)) {
