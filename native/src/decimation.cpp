@@ -267,8 +267,8 @@ void decimate(SimplexStore& store, const std::vector<VertexSplitIds>& splits,
   // Every simplex a merge looks up holds v1 and was in v1's star before
   // the merge (see below): it is looked up there, by binary search.
   std::vector<uint32_t> star2;
-  std::vector<StarEntry> star, starOfKept;
-  std::array<size_t, 5> begin{}, beginOfKept{};
+  std::vector<StarEntry> starOfKept, takenOver;
+  std::array<size_t, 5> beginOfKept{};
   // The simplex of v1's star before the merge with these other vertices
   // (ascending, `dimension` of them), or kNoSimplex.
   auto findAroundKept = [&](int dimension, const uint32_t* others) {
@@ -299,6 +299,7 @@ void decimate(SimplexStore& store, const std::vector<VertexSplitIds>& splits,
     // lookups find simplices that hold v1 but not v2, and none of the merge's
     // changes makes or kills one: v1's star before the merge answers them.
     gatherStar(store, v1, starOfKept, beginOfKept);
+    takenOver.clear();  // v2's simplices that take v1 for v2, by dimension
     const bool joined = findAroundKept(1, &v2) != kNoSimplex;
     uint32_t joiningLabel = kNoLabel;  // of the edge v1 v2
 
@@ -337,6 +338,10 @@ void decimate(SimplexStore& store, const std::vector<VertexSplitIds>& splits,
           store.setVertex(d, s, position, v1);
           store.link(d, s, position);
           scratch[size_t(d)][s] = 1;
+          StarEntry& entry = takenOver.emplace_back();
+          entry.simplex = s;
+          entry.dimension = uint8_t(d);
+          std::copy_n(twinOthers, 3, entry.others);
           continue;
         }
         // Both have it: code 3 (or 4, marked by the simplex one dimension up).
@@ -359,14 +364,11 @@ void decimate(SimplexStore& store, const std::vector<VertexSplitIds>& splits,
       }
     }
 
-    gatherStar(store, v1, star, begin);
     const size_t first = reversed.size();
     reversed.push_back(joined ? 3 : 2);
     const size_t firstLabel = reversedLabels.size();
     if (labelled && joined) reversedLabels.push_back(joiningLabel);
-    for (size_t i = 1; i < star.size(); ++i) {
-      const int d = star[i].dimension;
-      const uint32_t simplex = star[i].simplex;
+    auto record = [&](int d, uint32_t simplex) {
       uint8_t& bits = scratch[size_t(d)][simplex];
       const uint8_t code = (bits & kHasAdded) ? 3 : (bits & kHasCopy) ? 2 : (bits & split_record::kCodeMask);
       reversed.push_back(uint8_t(code | (bits & 0x3c)));
@@ -375,6 +377,23 @@ void decimate(SimplexStore& store, const std::vector<VertexSplitIds>& splits,
         if (bits & kHasAdded) reversedLabels.push_back(addedLabel[size_t(d)][simplex]);
       }
       bits = 0;
+    };
+    // One record per simplex of v1's star after the merge, in canonical
+    // order: the simplices of its star before the merge that do not hold v2
+    // (those that did were killed), merged with those taken over from v2.
+    for (size_t d = 1, taken = 0; d <= 3; ++d) {
+      const size_t takenFrom = taken;
+      while (taken < takenOver.size() && takenOver[taken].dimension == d) ++taken;
+      sortStarEntries(takenOver, takenFrom, taken, int(d));
+      size_t next = takenFrom;
+      for (size_t i = beginOfKept[d]; i < beginOfKept[d + 1]; ++i) {
+        const StarEntry& kept = starOfKept[i];
+        if (containsVertex(kept.others, int(d), v2)) continue;
+        for (; next < taken && lessOthers(takenOver[next].others, kept.others, int(d)); ++next)
+          record(int(d), takenOver[next].simplex);
+        record(int(d), kept.simplex);
+      }
+      for (; next < taken; ++next) record(int(d), takenOver[next].simplex);
     }
     recordLength[k] = reversed.size() - first;
     if (labelled) labelLength[k] = reversedLabels.size() - firstLabel;

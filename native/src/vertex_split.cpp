@@ -6,13 +6,14 @@
 #include <utility>
 
 namespace kdmesh {
-namespace {
 
 bool lessOthers(const uint32_t* a, const uint32_t* b, int count) {
   for (int i = 0; i < count; ++i)
     if (a[i] != b[i]) return a[i] < b[i];
   return false;
 }
+
+namespace {
 
 // Number of vertices of the simplex with a smaller id than `vertex`: the
 // position `vertex` would take in the ascending tuple.
@@ -28,12 +29,24 @@ uint64_t othersKey(const uint32_t* others, int count) {
   return count == 1 ? others[0] : uint64_t(others[0]) << 32 | others[1];
 }
 
+}  // namespace
+
+int splitBalance(uint32_t population, uint32_t first, bool geometric) {
+  if (!geometric) return 0;
+  const uint32_t second = population - first;
+  if (population == 2) return 1;
+  if (first <= 2 || second <= 2) return first == 1 ? 2 : second == 1 ? 3 : first == 2 ? 4 : 5;
+  // The lower half's share below 0.35, up to 0.65 or above, compared exactly.
+  const uint64_t scaledFirst = uint64_t(first) * 20, scaledPopulation = population;
+  return scaledFirst < 7 * scaledPopulation ? 6 : scaledFirst <= 13 * scaledPopulation ? 7 : 8;
+}
+
 // Sorts star[first, last), the entries of dimension d, by their other
 // vertices. A star's lists are short and arrive in no useful order: placing
 // each entry at its rank (how many keys are smaller, counted over a fixed
 // eight so that the count's loop always runs alike) takes no branch on the
 // keys, where a comparison sort mispredicts about once per entry.
-void sortByOthers(std::vector<StarEntry>& star, size_t first, size_t last, int d) {
+void sortStarEntries(std::vector<StarEntry>& star, size_t first, size_t last, int d) {
   constexpr size_t kRanked = 8;
   const size_t n = last - first;
   if (d > 2 || n > kRanked) {
@@ -50,18 +63,6 @@ void sortByOthers(std::vector<StarEntry>& star, size_t first, size_t last, int d
     ranked[rank] = star[first + i];
   }
   std::copy(ranked, ranked + n, star.begin() + std::ptrdiff_t(first));
-}
-
-}  // namespace
-
-int splitBalance(uint32_t population, uint32_t first, bool geometric) {
-  if (!geometric) return 0;
-  const uint32_t second = population - first;
-  if (population == 2) return 1;
-  if (first <= 2 || second <= 2) return first == 1 ? 2 : second == 1 ? 3 : first == 2 ? 4 : 5;
-  // The lower half's share below 0.35, up to 0.65 or above, compared exactly.
-  const uint64_t scaledFirst = uint64_t(first) * 20, scaledPopulation = population;
-  return scaledFirst < 7 * scaledPopulation ? 6 : scaledFirst <= 13 * scaledPopulation ? 7 : 8;
 }
 
 void gatherStar(SimplexStore& store, uint32_t v, std::vector<StarEntry>& star,
@@ -90,7 +91,7 @@ void gatherStar(SimplexStore& store, uint32_t v, std::vector<StarEntry>& star,
       sortFewVertices(entry.others, n);
       star.push_back(entry);
     });
-    sortByOthers(star, begin[size_t(d)], star.size(), d);
+    sortStarEntries(star, begin[size_t(d)], star.size(), d);
   }
   begin[4] = star.size();
 }

@@ -106,6 +106,11 @@ struct StarEntry {
 // dimension d, begin[4] the end.
 void gatherStar(SimplexStore& store, uint32_t v, std::vector<StarEntry>& star,
                 std::array<size_t, 5>& begin);
+// The canonical order of two entries of dimension `count`: whether the
+// other vertices `a` come before `b`.
+bool lessOthers(const uint32_t* a, const uint32_t* b, int count);
+// Sorts star[first, last), entries of dimension d, into canonical order.
+void sortStarEntries(std::vector<StarEntry>& star, size_t first, size_t last, int d);
 // The entry of dimension d of such a star whose other vertices are
 // `others` (d of them, ascending), or nullptr; d = 0 gives the vertex.
 const StarEntry* findInStar(const std::vector<StarEntry>& star, const std::array<size_t, 5>& begin, int dimension,
