@@ -185,10 +185,10 @@ class SimplexStore {
 
  private:
   struct Pool {
-    LargeArray<uint32_t> vertices;  // dimension + 1 per simplex
-    LargeArray<uint32_t> next;      // next slot in the vertex list, per slot
-    LargeArray<uint8_t> flags;
-    LargeArray<uint32_t> labels;    // labelled stores only
+    GrowingArray<uint32_t> vertices;  // dimension + 1 per simplex
+    GrowingArray<uint32_t> next;      // next slot in the vertex list, per slot
+    GrowingArray<uint8_t> flags;
+    GrowingArray<uint32_t> labels;    // labelled stores only
     uint32_t capacity = 0xffffffffu;
   };
 
