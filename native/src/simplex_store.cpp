@@ -38,13 +38,15 @@ uint32_t SimplexStore::add(int dimension, const uint32_t* vertices, uint8_t flag
   pool.flags.push_back(uint8_t(flags | kAlive));
   if (labelled_) pool.labels.push_back(label);
   ++live_[dimension];
-  // Vertices and slots pushed one by one: resize() and a range insert()
-  // are out-of-line calls, and this is one of the decoder's most frequent
-  // functions.
+  // Each slot goes to the head of its vertex's list, as link() puts it,
+  // from the vertex ids at hand (link() reads them back from the pool).
+  uint32_t* heads = heads_[dimension].data();
+  const uint32_t firstSlot = simplex * uint32_t(arity);
   for (uint32_t i = 0; i < arity; ++i) {
-    pool.vertices.push_back(vertices[i]);
-    pool.next.push_back(kNoSimplex);
-    link(dimension, simplex, i);
+    const uint32_t vertex = vertices[i];
+    pool.vertices.push_back(vertex);
+    pool.next.push_back(heads[vertex]);
+    heads[vertex] = firstSlot + i;
   }
   return simplex;
 }
