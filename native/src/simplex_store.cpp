@@ -38,8 +38,8 @@ uint32_t SimplexStore::add(int dimension, const uint32_t* vertices, uint8_t flag
   pool.flags.push_back(uint8_t(flags | kAlive));
   if (labelled_) pool.labels.push_back(label);
   ++live_[dimension];
-  // Each slot goes to the head of its vertex's list, as link() puts it,
-  // from the vertex ids at hand (link() reads them back from the pool).
+  // Each slot joins the head of its vertex's list, as link() puts it, from
+  // the vertex id at hand rather than read back from the pool.
   uint32_t* heads = heads_[dimension].data();
   const uint32_t firstSlot = simplex * uint32_t(arity);
   for (uint32_t i = 0; i < arity; ++i) {

@@ -23,6 +23,32 @@ TEST(LargeArray, HoldsValuesAsAVector) {
   EXPECT_EQ(copy, values);
 }
 
+TEST(GrowingArray, KeepsItsValuesThroughGrowthAndMoves) {
+  GrowingArray<uint32_t> values;
+  EXPECT_EQ(values.size(), 0u);
+  values.reserve(10);
+  EXPECT_EQ(values.size(), 0u);  // reserving adds no values
+  for (uint32_t i = 0; i < 3'000'000; ++i) values.push_back(i * 7);  // grows past the reserve and the advice threshold
+  ASSERT_EQ(values.size(), 3'000'000u);
+  for (uint32_t i = 0; i < values.size(); i += 99'991) ASSERT_EQ(values[i], i * 7);
+  EXPECT_EQ(values.data()[2'999'999], 2'999'999u * 7);
+  values.reserve(5);  // never shrinks
+  EXPECT_EQ(values[2'999'999], 2'999'999u * 7);
+
+  GrowingArray<uint32_t> moved(std::move(values));
+  EXPECT_EQ(moved.size(), 3'000'000u);
+  EXPECT_EQ(moved[12345], 12345u * 7);
+  GrowingArray<uint32_t> assigned;
+  assigned.push_back(1);
+  assigned = std::move(moved);
+  EXPECT_EQ(assigned.size(), 3'000'000u);
+  EXPECT_EQ(assigned[3], 21u);
+  assigned = GrowingArray<uint32_t>{};  // as a store's reset() empties its pools
+  EXPECT_EQ(assigned.size(), 0u);
+  assigned.push_back(9);
+  EXPECT_EQ(assigned[0], 9u);
+}
+
 #if defined(__linux__) && defined(MADV_HUGEPAGE)
 // The flags of the mapping that holds `address`, as /proc/self/smaps lists
 // them ("VmFlags: rd wr mr ... hg"), or "" if not found.
