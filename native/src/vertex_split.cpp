@@ -374,6 +374,153 @@ void VertexSplitter::linkFans() {
   }
 }
 
+bool VertexSplitter::gatherClosedFan(uint32_t v) {
+  constexpr int kMax = kLeanFanEdges;
+  if (store_.hasIncident(3, v)) return false;
+  // The edges, in canonical order (by their other vertex): keys of the
+  // other vertex and the list position, sorted by insertion.
+  const SimplexStore::Lists edges = store_.lists(1);
+  uint64_t edgeKeys[kMax];
+  uint32_t edgeSlots[kMax];
+  int n = 0;
+  for (uint32_t slot = edges.heads[v]; slot != kNoSimplex; slot = edges.next[slot]) {
+    if (!edges.alive(slot >> 1)) continue;
+    if (n == kMax) return false;
+    const uint64_t key = uint64_t(edges.vertices[slot ^ 1]) << 8 | uint64_t(n);
+    int j = n;
+    for (; j > 0 && edgeKeys[j - 1] > key; --j) edgeKeys[j] = edgeKeys[j - 1];
+    edgeKeys[j] = key;
+    edgeSlots[n++] = slot;
+  }
+  if (n < 3) return false;
+  if (edgeTo_.size() < store_.vertexCapacity()) edgeTo_.resize(store_.vertexCapacity());
+  for (int e = 0; e < n; ++e) edgeTo_[edgeKeys[e] >> 8] = uint32_t(1 + e);
+  // The star index of the edge to `vertex`, or kNoSimplex.
+  auto edgeTo = [&](uint32_t vertex) {
+    const uint32_t i = edgeTo_[vertex];
+    return i - 1 < uint32_t(n) && edgeKeys[i - 1] >> 8 == vertex ? i : kNoSimplex;
+  };
+  // The triangles, each by the star indices of its two edges through v.
+  // Their canonical order (by their other vertices) is that of these index
+  // pairs, smaller first; in a fan each edge is the smaller of at most two,
+  // so a bucket per edge orders them.
+  const SimplexStore::Lists triangles = store_.lists(2);
+  uint32_t byFirstEdge[kMax + 1][2];
+  for (int e = 1; e <= n; ++e) byFirstEdge[e][0] = byFirstEdge[e][1] = kNoSimplex;
+  uint32_t triangleSlots[kMax], triangleEdges[kMax][2];
+  int t = 0;
+  for (uint32_t slot = triangles.heads[v]; slot != kNoSimplex; slot = triangles.next[slot]) {
+    const uint32_t triangle = slot / 3;
+    if (!triangles.alive(triangle)) continue;
+    if (t == n) return false;  // more triangles than edges: no closed fan
+    const uint32_t* tuple = triangles.vertices + size_t(triangle) * 3;
+    const uint32_t position = slot - triangle * 3;
+    const uint32_t a = edgeTo(tuple[position == 0 ? 1 : 0]), b = edgeTo(tuple[position == 2 ? 1 : 2]);
+    if (a == kNoSimplex || b == kNoSimplex || a == b) return false;
+    const uint32_t first = std::min(a, b), second = std::max(a, b);
+    uint32_t* bucket = byFirstEdge[first];
+    if (bucket[0] == kNoSimplex) {
+      bucket[0] = uint32_t(t);
+    } else if (bucket[1] != kNoSimplex) {
+      return false;
+    } else if (second < triangleEdges[bucket[0]][1]) {  // within a bucket, by the second edge
+      bucket[1] = bucket[0];
+      bucket[0] = uint32_t(t);
+    } else {
+      bucket[1] = uint32_t(t);
+    }
+    triangleSlots[t] = slot;
+    triangleEdges[t][0] = first;
+    triangleEdges[t++][1] = second;
+  }
+  if (t != n) return false;
+  uint8_t triangleOrder[kMax];
+  int ordered = 0;
+  for (int e = 1; e <= n; ++e)
+    for (const uint32_t triangle : byFirstEdge[e])
+      if (triangle != kNoSimplex) triangleOrder[ordered++] = uint8_t(triangle);
+  // Each triangle links its two edges, in canonical order, as linkFans()
+  // does; a fan has two links per edge and no more.
+  uint32_t links[kMax + 1][2];
+  for (int e = 1; e <= n; ++e) links[e][0] = links[e][1] = kNoSimplex;
+  auto link = [&links](uint32_t from, uint32_t to) {
+    uint32_t* free = links[from][0] == kNoSimplex ? &links[from][0] : &links[from][1];
+    const bool room = *free == kNoSimplex;
+    *free = to;
+    return room;
+  };
+  for (int i = 0; i < n; ++i) {
+    const uint32_t* ends = triangleEdges[triangleOrder[i]];
+    if (!link(ends[0], ends[1]) || !link(ends[1], ends[0])) return false;
+  }
+  for (int e = 1; e <= n; ++e)
+    if (links[e][1] == kNoSimplex) return false;
+  // The walk of indexFan(): from the first edge on to its links[0].
+  uint8_t fanIndex[kMax + 1];
+  fanOrder_.clear();
+  uint32_t previous = links[1][1], at = 1;
+  do {
+    fanIndex[at] = uint8_t(fanOrder_.size());
+    fanOrder_.push_back(at);
+    const uint32_t next = links[at][0] ^ links[at][1] ^ previous;
+    previous = at;
+    at = next;
+  } while (at != 1 && fanOrder_.size() <= size_t(n));
+  if (at != 1 || fanOrder_.size() != size_t(n)) return false;
+
+  // The entries as gatherStar() and linkFans() leave them.
+  star_.resize(size_t(1 + 2 * n));
+  StarEntry entry{};
+  entry.simplex = entry.copy = entry.added = kNoSimplex;
+  star_[0] = entry;
+  for (int e = 0; e < n; ++e) {
+    const uint32_t slot = edgeSlots[edgeKeys[e] & 0xff];
+    StarEntry& edge = star_[size_t(1 + e)];
+    edge = entry;
+    edge.simplex = slot >> 1;
+    edge.dimension = 1;
+    edge.position = uint8_t(slot & 1);
+    edge.others[0] = uint32_t(edgeKeys[e] >> 8);
+    edge.links[0] = links[1 + e][0];
+    edge.links[1] = links[1 + e][1];
+    edge.fanIndex = fanIndex[1 + e];
+  }
+  for (int i = 0; i < n; ++i) {
+    const uint32_t slot = triangleSlots[triangleOrder[i]];
+    const uint32_t* ends = triangleEdges[triangleOrder[i]];
+    StarEntry& triangle = star_[size_t(1 + n + i)];
+    triangle = entry;
+    triangle.simplex = slot / 3;
+    triangle.dimension = 2;
+    triangle.position = uint8_t(slot - triangle.simplex * 3);
+    triangle.others[0] = star_[ends[0]].others[0];
+    triangle.others[1] = star_[ends[1]].others[0];
+    triangle.links[0] = ends[0];
+    triangle.links[1] = ends[1];
+  }
+  begin_ = {0, 1, size_t(1 + n), size_t(1 + 2 * n), size_t(1 + 2 * n)};
+  crowdedLinks_ = 0;
+  fanSize_ = n;
+  firstCut_ = -1;
+#ifdef KDMESH_CHECK_FANS
+  // The general path must find the same star.
+  const std::vector<StarEntry> lean = star_;
+  const std::vector<uint32_t> leanOrder = fanOrder_;
+  gatherStar(store_, v, star_, begin_);
+  linkFans();
+  if (fanSize_ != n || fanOrder_ != leanOrder || star_.size() != lean.size()) std::abort();
+  for (size_t i = 0; i < lean.size(); ++i) {
+    const StarEntry &a = lean[i], &b = star_[i];
+    const bool sameOthers = std::equal(a.others, a.others + a.dimension, b.others);
+    const bool sameLinks = a.dimension == 0 || (a.links[0] == b.links[0] && a.links[1] == b.links[1]);
+    if (a.simplex != b.simplex || a.dimension != b.dimension || a.position != b.position || !sameOthers ||
+        !sameLinks || (a.dimension == 1 && a.fanIndex != b.fanIndex))
+      std::abort();
+  }
+#endif
+  return true;
+}
+
 // Numbers the edges around the fan when the star's edges form one closed
 // fan (each in two triangles, one cycle); fanSize_ is 0 otherwise.
 void VertexSplitter::indexFan() {
