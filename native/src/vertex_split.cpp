@@ -463,6 +463,7 @@ bool VertexSplitter::gatherClosedFan(uint32_t v) {
     fanIndex[at] = uint8_t(fanOrder_.size());
     fanOrder_.push_back(at);
     const uint32_t next = links[at][0] ^ links[at][1] ^ previous;
+    if (next - 1 >= uint32_t(n)) return false;  // links that are not mutual
     previous = at;
     at = next;
   } while (at != 1 && fanOrder_.size() <= size_t(n));
