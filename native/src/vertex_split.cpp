@@ -434,46 +434,13 @@ bool VertexSplitter::gatherClosedFan(uint32_t v) {
     triangleEdges[t++][1] = second;
   }
   if (t != n) return false;
-  uint8_t triangleOrder[kMax];
-  int ordered = 0;
-  for (int e = 1; e <= n; ++e)
-    for (const uint32_t triangle : byFirstEdge[e])
-      if (triangle != kNoSimplex) triangleOrder[ordered++] = uint8_t(triangle);
-  // Each triangle links its two edges, in canonical order, as linkFans()
-  // does; a fan has two links per edge and no more.
-  uint32_t links[kMax + 1][2];
-  for (int e = 1; e <= n; ++e) links[e][0] = links[e][1] = kNoSimplex;
-  auto link = [&links](uint32_t from, uint32_t to) {
-    uint32_t* free = links[from][0] == kNoSimplex ? &links[from][0] : &links[from][1];
-    const bool room = *free == kNoSimplex;
-    *free = to;
-    return room;
-  };
-  for (int i = 0; i < n; ++i) {
-    const uint32_t* ends = triangleEdges[triangleOrder[i]];
-    if (!link(ends[0], ends[1]) || !link(ends[1], ends[0])) return false;
-  }
-  for (int e = 1; e <= n; ++e)
-    if (links[e][1] == kNoSimplex) return false;
-  // The walk of indexFan(): from the first edge on to its links[0].
-  uint8_t fanIndex[kMax + 1];
-  fanOrder_.clear();
-  uint32_t previous = links[1][1], at = 1;
-  do {
-    fanIndex[at] = uint8_t(fanOrder_.size());
-    fanOrder_.push_back(at);
-    const uint32_t next = links[at][0] ^ links[at][1] ^ previous;
-    if (next - 1 >= uint32_t(n)) return false;  // links that are not mutual
-    previous = at;
-    at = next;
-  } while (at != 1 && fanOrder_.size() <= size_t(n));
-  if (at != 1 || fanOrder_.size() != size_t(n)) return false;
-
-  // The entries as gatherStar() and linkFans() leave them.
+  // The entries as gatherStar() leaves them, then the links and the fan
+  // order as linkFans() and indexFan() make them.
   star_.resize(size_t(1 + 2 * n));
   StarEntry entry{};
   entry.simplex = entry.copy = entry.added = kNoSimplex;
   star_[0] = entry;
+  entry.links[0] = entry.links[1] = kNoSimplex;
   for (int e = 0; e < n; ++e) {
     const uint32_t slot = edgeSlots[edgeKeys[e] & 0xff];
     StarEntry& edge = star_[size_t(1 + e)];
@@ -482,27 +449,36 @@ bool VertexSplitter::gatherClosedFan(uint32_t v) {
     edge.dimension = 1;
     edge.position = uint8_t(slot & 1);
     edge.others[0] = uint32_t(edgeKeys[e] >> 8);
-    edge.links[0] = links[1 + e][0];
-    edge.links[1] = links[1 + e][1];
-    edge.fanIndex = fanIndex[1 + e];
   }
-  for (int i = 0; i < n; ++i) {
-    const uint32_t slot = triangleSlots[triangleOrder[i]];
-    const uint32_t* ends = triangleEdges[triangleOrder[i]];
-    StarEntry& triangle = star_[size_t(1 + n + i)];
-    triangle = entry;
-    triangle.simplex = slot / 3;
-    triangle.dimension = 2;
-    triangle.position = uint8_t(slot - triangle.simplex * 3);
-    triangle.others[0] = star_[ends[0]].others[0];
-    triangle.others[1] = star_[ends[1]].others[0];
-    triangle.links[0] = ends[0];
-    triangle.links[1] = ends[1];
-  }
+  // Each triangle links its two edges, in canonical order as linkFans()
+  // does; a fan has two links per edge and no more.
+  auto link = [this](uint32_t from, uint32_t to) {
+    uint32_t* links = star_[from].links;
+    uint32_t* free = links[0] == kNoSimplex ? &links[0] : &links[1];
+    const bool room = *free == kNoSimplex;
+    *free = to;
+    return room;
+  };
+  size_t at = size_t(1 + n);
+  for (int e = 1; e <= n; ++e)
+    for (const uint32_t t : byFirstEdge[e]) {
+      if (t == kNoSimplex) continue;
+      const uint32_t a = triangleEdges[t][0], b = triangleEdges[t][1];
+      StarEntry& triangle = star_[at++];
+      triangle = entry;
+      triangle.simplex = triangleSlots[t] / 3;
+      triangle.dimension = 2;
+      triangle.position = uint8_t(triangleSlots[t] - triangle.simplex * 3);
+      triangle.others[0] = star_[a].others[0];
+      triangle.others[1] = star_[b].others[0];
+      triangle.links[0] = a;
+      triangle.links[1] = b;
+      if (!link(a, b) || !link(b, a)) return false;
+    }
   begin_ = {0, 1, size_t(1 + n), size_t(1 + 2 * n), size_t(1 + 2 * n)};
   crowdedLinks_ = 0;
-  fanSize_ = n;
-  firstCut_ = -1;
+  indexFan();
+  if (fanSize_ == 0) return false;
 #ifdef KDMESH_CHECK_FANS
   // The general path must find the same star.
   const std::vector<StarEntry> lean = star_;
