@@ -33,8 +33,10 @@ uint32_t SimplexStore::add(int dimension, const uint32_t* vertices, uint8_t flag
   Pool& pool = pool_[dimension];
   const uint32_t simplex = uint32_t(pool.flags.size());
   const size_t arity = size_t(dimension + 1);
-  // Slots are simplex * arity + position in 32 bits.
-  if (simplex >= pool.capacity || simplex >= 0xfffffff0u / arity) return kNoSimplex;
+  // Slots are simplex * arity + position in 32 bits (a product, not a
+  // quotient: the arity is not known at compile time, and a division is
+  // slow).
+  if (simplex >= pool.capacity || uint64_t(simplex) * arity >= 0xfffffff0u) return kNoSimplex;
   pool.flags.push_back(uint8_t(flags | kAlive));
   if (labelled_) pool.labels.push_back(label);
   ++live_[dimension];

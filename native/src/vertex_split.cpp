@@ -29,6 +29,27 @@ uint64_t othersKey(const uint32_t* others, int count) {
   return count == 1 ? others[0] : uint64_t(others[0]) << 32 | others[1];
 }
 
+// Sorts n distinct keys ascending. Up to eight are placed at their rank
+// (how many keys are smaller, counted over a fixed eight so that the
+// count's loop always runs alike), which takes no branch on the keys, where
+// an insertion sort mispredicts about once per key.
+void sortDistinctKeys(uint64_t* keys, int n) {
+  constexpr int kRanked = 8;
+  if (n > kRanked) {
+    std::sort(keys, keys + n);
+    return;
+  }
+  // Padding keys rank above every key and all land on ranked[n].
+  uint64_t padded[kRanked], ranked[kRanked + 1];
+  for (int i = 0; i < kRanked; ++i) padded[i] = i < n ? keys[i] : ~uint64_t(0);
+  for (int i = 0; i < kRanked; ++i) {
+    int rank = 0;
+    for (int j = 0; j < kRanked; ++j) rank += padded[j] < padded[i];
+    ranked[rank] = padded[i];
+  }
+  std::copy(ranked, ranked + n, keys);
+}
+
 }  // namespace
 
 int splitBalance(uint32_t population, uint32_t first, bool geometric) {
@@ -378,7 +399,7 @@ bool VertexSplitter::gatherClosedFan(uint32_t v) {
   constexpr int kMax = kLeanFanEdges;
   if (store_.hasIncident(3, v)) return false;
   // The edges, in canonical order (by their other vertex): keys of the
-  // other vertex and the list position, sorted by insertion.
+  // other vertex and the list position, sorted.
   const SimplexStore::Lists edges = store_.lists(1);
   uint64_t edgeKeys[kMax];
   uint32_t edgeSlots[kMax];
@@ -386,13 +407,11 @@ bool VertexSplitter::gatherClosedFan(uint32_t v) {
   for (uint32_t slot = edges.heads[v]; slot != kNoSimplex; slot = edges.next[slot]) {
     if (!edges.alive(slot >> 1)) continue;
     if (n == kMax) return false;
-    const uint64_t key = uint64_t(edges.vertices[slot ^ 1]) << 8 | uint64_t(n);
-    int j = n;
-    for (; j > 0 && edgeKeys[j - 1] > key; --j) edgeKeys[j] = edgeKeys[j - 1];
-    edgeKeys[j] = key;
+    edgeKeys[n] = uint64_t(edges.vertices[slot ^ 1]) << 8 | uint64_t(n);
     edgeSlots[n++] = slot;
   }
   if (n < 3) return false;
+  sortDistinctKeys(edgeKeys, n);
   if (edgeTo_.size() < store_.vertexCapacity()) edgeTo_.resize(store_.vertexCapacity());
   for (int e = 0; e < n; ++e) edgeTo_[edgeKeys[e] >> 8] = uint32_t(1 + e);
   // The star index of the edge to `vertex`, or kNoSimplex.
@@ -402,12 +421,10 @@ bool VertexSplitter::gatherClosedFan(uint32_t v) {
   };
   // The triangles, each by the star indices of its two edges through v.
   // Their canonical order (by their other vertices) is that of these index
-  // pairs, smaller first; in a fan each edge is the smaller of at most two,
-  // so a bucket per edge orders them.
+  // pairs, smaller first: keys of the pair and the list position, sorted.
   const SimplexStore::Lists triangles = store_.lists(2);
-  uint32_t byFirstEdge[kMax + 1][2];
-  for (int e = 1; e <= n; ++e) byFirstEdge[e][0] = byFirstEdge[e][1] = kNoSimplex;
-  uint32_t triangleSlots[kMax], triangleEdges[kMax][2];
+  uint64_t triangleKeys[kMax];
+  uint32_t triangleSlots[kMax];
   int t = 0;
   for (uint32_t slot = triangles.heads[v]; slot != kNoSimplex; slot = triangles.next[slot]) {
     const uint32_t triangle = slot / 3;
@@ -417,23 +434,13 @@ bool VertexSplitter::gatherClosedFan(uint32_t v) {
     const uint32_t position = slot - triangle * 3;
     const uint32_t a = edgeTo(tuple[position == 0 ? 1 : 0]), b = edgeTo(tuple[position == 2 ? 1 : 2]);
     if (a == kNoSimplex || b == kNoSimplex || a == b) return false;
-    const uint32_t first = std::min(a, b), second = std::max(a, b);
-    uint32_t* bucket = byFirstEdge[first];
-    if (bucket[0] == kNoSimplex) {
-      bucket[0] = uint32_t(t);
-    } else if (bucket[1] != kNoSimplex) {
-      return false;
-    } else if (second < triangleEdges[bucket[0]][1]) {  // within a bucket, by the second edge
-      bucket[1] = bucket[0];
-      bucket[0] = uint32_t(t);
-    } else {
-      bucket[1] = uint32_t(t);
-    }
-    triangleSlots[t] = slot;
-    triangleEdges[t][0] = first;
-    triangleEdges[t++][1] = second;
+    // The smaller index first, by arithmetic: which one it is is a coin toss.
+    const uint32_t swap = (a ^ b) & (0u - uint32_t(b < a));
+    triangleKeys[t] = uint64_t(a ^ swap) << 16 | uint64_t(b ^ swap) << 8 | uint64_t(t);
+    triangleSlots[t++] = slot;
   }
   if (t != n) return false;
+  sortDistinctKeys(triangleKeys, n);
   // The entries as gatherStar() leaves them, then the links and the fan
   // order as linkFans() and indexFan() make them.
   star_.resize(size_t(1 + 2 * n));
@@ -451,30 +458,31 @@ bool VertexSplitter::gatherClosedFan(uint32_t v) {
     edge.others[0] = uint32_t(edgeKeys[e] >> 8);
   }
   // Each triangle links its two edges, in canonical order as linkFans()
-  // does; a fan has two links per edge and no more.
-  auto link = [this](uint32_t from, uint32_t to) {
-    uint32_t* links = star_[from].links;
-    uint32_t* free = links[0] == kNoSimplex ? &links[0] : &links[1];
-    const bool room = *free == kNoSimplex;
-    *free = to;
-    return room;
+  // does; a fan has two links per edge and no more. Which link is free is
+  // counted per edge, not tested.
+  uint8_t linked[kMax + 1] = {};
+  bool room = true;
+  auto link = [&](uint32_t from, uint32_t to) {
+    star_[from].links[linked[from] != 0] = to;
+    room &= linked[from] < 2;
+    ++linked[from];
   };
-  size_t at = size_t(1 + n);
-  for (int e = 1; e <= n; ++e)
-    for (const uint32_t t : byFirstEdge[e]) {
-      if (t == kNoSimplex) continue;
-      const uint32_t a = triangleEdges[t][0], b = triangleEdges[t][1];
-      StarEntry& triangle = star_[at++];
-      triangle = entry;
-      triangle.simplex = triangleSlots[t] / 3;
-      triangle.dimension = 2;
-      triangle.position = uint8_t(triangleSlots[t] - triangle.simplex * 3);
-      triangle.others[0] = star_[a].others[0];
-      triangle.others[1] = star_[b].others[0];
-      triangle.links[0] = a;
-      triangle.links[1] = b;
-      if (!link(a, b) || !link(b, a)) return false;
-    }
+  for (int k = 0; k < n; ++k) {
+    const uint64_t key = triangleKeys[k];
+    const uint32_t a = uint32_t(key >> 16), b = uint32_t(key >> 8) & 0xff, slot = triangleSlots[key & 0xff];
+    StarEntry& triangle = star_[size_t(1 + n + k)];
+    triangle = entry;
+    triangle.simplex = slot / 3;
+    triangle.dimension = 2;
+    triangle.position = uint8_t(slot - triangle.simplex * 3);
+    triangle.others[0] = star_[a].others[0];
+    triangle.others[1] = star_[b].others[0];
+    triangle.links[0] = a;
+    triangle.links[1] = b;
+    link(a, b);
+    link(b, a);
+  }
+  if (!room) return false;
   begin_ = {0, 1, size_t(1 + n), size_t(1 + 2 * n), size_t(1 + 2 * n)};
   crowdedLinks_ = 0;
   indexFan();
