@@ -29,25 +29,30 @@ uint64_t othersKey(const uint32_t* others, int count) {
   return count == 1 ? others[0] : uint64_t(others[0]) << 32 | others[1];
 }
 
-// Sorts n distinct keys ascending. Up to eight are placed at their rank
-// (how many keys are smaller, counted over a fixed eight so that the
-// count's loop always runs alike), which takes no branch on the keys, where
-// an insertion sort mispredicts about once per key.
+// A key above every key that sortDistinctKeys() sorts.
+constexpr uint64_t kPaddingKey = ~uint64_t(0);
+constexpr int kRankedKeys = 8;
+
+// Sorts keys[0..n) ascending; the keys are distinct, and below
+// kRankedKeys keys[n..kRankedKeys) hold kPaddingKey. Up to kRankedKeys are
+// placed at their rank (how many keys are smaller, counted over all of
+// them, padding included, so that every loop runs a fixed count): no branch
+// on the keys or on n, where an insertion sort mispredicts about once per
+// key.
 void sortDistinctKeys(uint64_t* keys, int n) {
-  constexpr int kRanked = 8;
-  if (n > kRanked) {
+  if (n > kRankedKeys) {
     std::sort(keys, keys + n);
     return;
   }
-  // Padding keys rank above every key and all land on ranked[n].
-  uint64_t padded[kRanked], ranked[kRanked + 1];
-  for (int i = 0; i < kRanked; ++i) padded[i] = i < n ? keys[i] : ~uint64_t(0);
-  for (int i = 0; i < kRanked; ++i) {
+  // The padding keys all rank n and land on ranked[n].
+  uint64_t ranked[kRankedKeys + 1];
+  std::fill_n(ranked, kRankedKeys + 1, kPaddingKey);
+  for (int i = 0; i < kRankedKeys; ++i) {
     int rank = 0;
-    for (int j = 0; j < kRanked; ++j) rank += padded[j] < padded[i];
-    ranked[rank] = padded[i];
+    for (int j = 0; j < kRankedKeys; ++j) rank += keys[j] < keys[i];
+    ranked[rank] = keys[i];
   }
-  std::copy(ranked, ranked + n, keys);
+  std::copy_n(ranked, kRankedKeys, keys);
 }
 
 }  // namespace
@@ -397,11 +402,13 @@ void VertexSplitter::linkFans() {
 
 bool VertexSplitter::gatherClosedFan(uint32_t v) {
   constexpr int kMax = kLeanFanEdges;
+  static_assert(kMax >= kRankedKeys);
   if (store_.hasIncident(3, v)) return false;
   // The edges, in canonical order (by their other vertex): keys of the
   // other vertex and the list position, sorted.
   const SimplexStore::Lists edges = store_.lists(1);
   uint64_t edgeKeys[kMax];
+  std::fill_n(edgeKeys, kRankedKeys, kPaddingKey);
   uint32_t edgeSlots[kMax];
   int n = 0;
   for (uint32_t slot = edges.heads[v]; slot != kNoSimplex; slot = edges.next[slot]) {
@@ -424,6 +431,7 @@ bool VertexSplitter::gatherClosedFan(uint32_t v) {
   // pairs, smaller first: keys of the pair and the list position, sorted.
   const SimplexStore::Lists triangles = store_.lists(2);
   uint64_t triangleKeys[kMax];
+  std::fill_n(triangleKeys, kRankedKeys, kPaddingKey);
   uint32_t triangleSlots[kMax];
   int t = 0;
   for (uint32_t slot = triangles.heads[v]; slot != kNoSimplex; slot = triangles.next[slot]) {
