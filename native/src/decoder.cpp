@@ -243,7 +243,7 @@ struct Decoder::State {
         store.growVertices(std::min<uint32_t>(header.vertexCount, 2 * store.vertexCapacity()));
       const double before = coder.cost(), labelsBefore = splitter->labelBits();
       if (!splitter->split(coder, cell.vertex, added, level, splitBalance(population, firstHalf, geometric),
-                           [] { return uint8_t(0); }, [] { return kNoLabel; }))
+                           NoRecords{}, [] { return kNoLabel; }))
         return false;
       const double labelBits = splitter->labelBits() - labelsBefore;
       cost.labelBits += labelBits;

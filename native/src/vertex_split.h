@@ -49,6 +49,7 @@
 #include <array>
 #include <cstdint>
 #include <optional>
+#include <type_traits>
 #include <vector>
 
 #include "kdmesh/kdmesh.h"
@@ -70,6 +71,12 @@ constexpr uint8_t kFree = 0;            // target: any orientation will do
 constexpr uint8_t kParity0 = 2, kParity1 = 3;
 inline uint8_t target(int parity) { return uint8_t(kParity0 + parity); }
 }  // namespace split_record
+
+// The decoder's oracle: it has no records, and split() leaves each star
+// entry's record 0 without asking for one.
+struct NoRecords {
+  uint8_t operator()() const { return 0; }
+};
 
 // How a cell's vertices divide between the halves of its split, `first` of
 // `population` in the lower half: a class of the star's edge codes (a half
@@ -163,8 +170,9 @@ class VertexSplitter {
 
   // Splits `v`, whose cell is at `level`, into `v` and `v2`; `balance`:
   // splitBalance() of the cell's split. `oracle()` gives the record byte of
-  // each star entry in canonical order, `labelOracle()` the label of each
-  // new simplex (SplitRecords::labels) when labels are enabled.
+  // each star entry in canonical order (the decoder passes NoRecords),
+  // `labelOracle()` the label of each new simplex (SplitRecords::labels)
+  // when labels are enabled.
   // Returns false when the codes contradict each other, a label is not in
   // the table or the store is full: corrupt data on the decoder.
   template <class Coder, class Oracle, class LabelOracle>
@@ -388,6 +396,7 @@ class VertexSplitter {
   // Per fan position, the star index of its triangle.
   std::vector<uint32_t> slotTriangles_;
   bool fanExpansionCoded_ = false;  // the split under way was coded by codeFanExpansion()
+  std::array<uint32_t, 2> fanCutEntries_{};  // its two cut edges' star indices, ascending
   // Orientation models: [dimension - 2][copy or new][vote class][face of higher].
   BitModel orientationModels_[2][2][3][2];
   std::optional<LabelCoder> labels_;
@@ -538,11 +547,12 @@ void VertexSplitter::codeFanExpansion(Coder& coder) {
     ++statistics_.codes[1][code - 1];
   };
   int cuts = 0, firstCut = -1;
+  int cutAt[2] = {0, 0};  // the two cuts' fan positions
   uint8_t side;  // of the arc the walk is in
   const int next = fanNext(start);
   if (coder.bit(startCutModels_[bucketAt(start)], recorded(start) == 4)) {
     cuts = 1;
-    firstCut = start;
+    firstCut = cutAt[0] = start;
     give(start, 4);
     // The arc after the cut: the next edge's side, or, when that is the
     // other cut, the opposite of the edge after it.
@@ -575,6 +585,7 @@ void VertexSplitter::codeFanExpansion(Coder& coder) {
       cut = coder.bit(fanCutModels_[context], recorded(k) == 4);
     }
     if (cut) {
+      cutAt[cuts] = k;
       if (++cuts == 1) firstCut = k;
       side = uint8_t(3 - side);
     }
@@ -591,6 +602,8 @@ void VertexSplitter::codeFanExpansion(Coder& coder) {
     star_[t].code = code;
     ++statistics_.codes[2][code - 1];
   }
+  const uint32_t cutA = fanOrder_[size_t(cutAt[0])], cutB = fanOrder_[size_t(cutAt[1])];
+  fanCutEntries_ = {std::min(cutA, cutB), std::max(cutA, cutB)};
   fanExpansionCoded_ = true;
   ++statistics_.fanExpansions;
 }
@@ -609,7 +622,8 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int
   int cutEdges = 0;  // edges coded 4: an edge expansion has two
   bool codedThree = false;
   // The encoder's records come in canonical order.
-  for (Entry& entry : star_) entry.record = oracle();
+  if constexpr (!std::is_same_v<std::decay_t<Oracle>, NoRecords>)
+    for (Entry& entry : star_) entry.record = oracle();
   bool coded = false;
   fanExpansionCoded_ = false;
   if (fanExpansions_ && geometric && closedFanStar()) {
@@ -666,14 +680,22 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int
   // the index of an earlier split.
   aroundReady_.fill(false);
   for (std::vector<FacetEntry>& facets : facets_) facets.clear();
-  for (const Entry& entry : star_) {
-    const int d = entry.dimension;
-    if (entry.copy != kNoSimplex && d >= 2)
-      decideOrientation(coder, d, entry.copy, entry, true,
-                        uint8_t((entry.record >> split_record::kCopyTargetShift) & 3));
-    if (entry.added != kNoSimplex && d + 1 >= 2)
-      decideOrientation(coder, d + 1, entry.added, entry, false,
-                        uint8_t((entry.record >> split_record::kNewTargetShift) & 3));
+  auto orientAdded = [&](const Entry& entry) {
+    decideOrientation(coder, entry.dimension + 1, entry.added, entry, false,
+                      uint8_t((entry.record >> split_record::kNewTargetShift) & 3));
+  };
+  if (fanExpansionCoded_) {
+    // Its only new simplices with an orientation: the triangles that the
+    // two cut edges added, in star order as below.
+    for (const uint32_t cut : fanCutEntries_) orientAdded(star_[cut]);
+  } else {
+    for (const Entry& entry : star_) {
+      const int d = entry.dimension;
+      if (entry.copy != kNoSimplex && d >= 2)
+        decideOrientation(coder, d, entry.copy, entry, true,
+                          uint8_t((entry.record >> split_record::kCopyTargetShift) & 3));
+      if (entry.added != kNoSimplex && d + 1 >= 2) orientAdded(entry);
+    }
   }
   if (labels_) {
     const double before = coder.cost();
