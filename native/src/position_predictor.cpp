@@ -568,6 +568,18 @@ bool PositionPredictor::alongAxisContext(uint32_t vertex, int level, int& contex
   return true;
 }
 
+template <class Coder>
+bool PositionPredictor::codeSingleAlongAxis(Coder& coder, CountCoder& counts, uint32_t vertex, int level,
+                                            bool parentOneSided, bool inFirstHalf) {
+  int context = 0;
+  bool mirrored = false;
+  if (!alongAxisContext(vertex, level, context, mirrored))
+    return counts.codeSingle(coder, level, parentOneSided, inFirstHalf);
+  return coder.bit(alongAxisModels_[size_t(context)], inFirstHalf != mirrored) != mirrored;
+}
+template bool PositionPredictor::codeSingleAlongAxis(RangeEncoder&, CountCoder&, uint32_t, int, bool, bool);
+template bool PositionPredictor::codeSingleAlongAxis(RangeDecoder&, CountCoder&, uint32_t, int, bool, bool);
+
 // The class by where the centroid lies, as for a vertex in no triangle.
 CountContext PositionPredictor::alongAxisCountContext(uint32_t vertex, int level) {
   AlongAxisBins bins;

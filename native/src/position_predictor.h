@@ -163,17 +163,12 @@ class PositionPredictor {
   }
 
   // codeSingle() of a stream coded for fast decoding, without moving the
-  // cell. Out of line: inlined, it made the loop of the default coding
-  // slower.
+  // cell. Out of line (inlined, it made the loop of the default coding
+  // slower), in position_predictor.cpp with the walk it inlines, for
+  // RangeEncoder and RangeDecoder.
   template <class Coder>
   [[gnu::noinline]] bool codeSingleAlongAxis(Coder& coder, CountCoder& counts, uint32_t vertex, int level,
-                                             bool parentOneSided, bool inFirstHalf) {
-    int context = 0;
-    bool mirrored = false;
-    if (!alongAxisContext(vertex, level, context, mirrored))
-      return counts.codeSingle(coder, level, parentOneSided, inFirstHalf);
-    return coder.bit(alongAxisModels_[size_t(context)], inFirstHalf != mirrored) != mirrored;
-  }
+                                             bool parentOneSided, bool inFirstHalf);
 
   // A split left `isolated` in no simplex and its cell's other half, the
   // vertex `sibling`, with the simplices (or both in none: `sibling` is
@@ -318,7 +313,7 @@ class PositionPredictor {
   bool contextsOf(uint32_t vertex, int level, SingleContexts& contexts);
   // Fast decoding: the model of a one-vertex split from the vertex's edges,
   // and whether it is mirrored; false for a vertex in no edge.
-  bool alongAxisContext(uint32_t vertex, int level, int& context, bool& mirrored);
+  [[gnu::always_inline]] inline bool alongAxisContext(uint32_t vertex, int level, int& context, bool& mirrored);
   // The bins of the neighbours through edges along the split axis and their
   // centroid's offset in half widths (fast decoding).
   [[gnu::always_inline]] inline bool gatherAlongAxis(uint32_t vertex, int level, AlongAxisBins& bins,
