@@ -33,12 +33,12 @@ uint64_t othersKey(const uint32_t* others, int count) {
 constexpr uint64_t kPaddingKey = ~uint64_t(0);
 constexpr int kRankedKeys = 8;
 
-// Sorts keys[0..n) ascending; the keys are distinct, and below
-// kRankedKeys keys[n..kRankedKeys) hold kPaddingKey. Up to kRankedKeys are
-// placed at their rank (how many keys are smaller, counted over all of
-// them, padding included, so that every loop runs a fixed count): no branch
-// on the keys or on n, where an insertion sort mispredicts about once per
-// key.
+// Sorts keys[0..n) ascending. The keys are distinct, and when n is at most
+// kRankedKeys, keys[n..kRankedKeys) hold kPaddingKey: each key is then
+// placed at its rank (how many keys are smaller, counted over all
+// kRankedKeys, padding included, so that every loop runs a fixed count),
+// with no branch on the keys or on n, where an insertion sort mispredicts
+// about once per key.
 void sortDistinctKeys(uint64_t* keys, int n) {
   if (n > kRankedKeys) {
     std::sort(keys, keys + n);
