@@ -523,20 +523,22 @@ void VertexSplitter::indexFan() {
   if (last - first < 3 || last - first > 255) return;
   for (size_t i = first; i < last; ++i)
     if (star_[i].links[1] == kNoSimplex) return;
-  fanOrder_.clear();
   // Links are mutual (linkFans() made each both ways, none dropped), so
   // the edge the walk came from is one of the two links and the next is
   // the other: their exclusive or without the previous one. Starting as
   // if from links[1] walks on to links[0].
+  const size_t edges = last - first;
+  fanOrder_.resize(edges);
   uint32_t previous = star_[first].links[1], at = uint32_t(first);
+  size_t walked = 0;
   do {
-    star_[at].fanIndex = uint8_t(fanOrder_.size());
-    fanOrder_.push_back(at);
+    star_[at].fanIndex = uint8_t(walked);
+    fanOrder_[walked++] = at;
     const uint32_t next = star_[at].links[0] ^ star_[at].links[1] ^ previous;
     previous = at;
     at = next;
-  } while (at != first && fanOrder_.size() <= last - first);
-  if (at == first && fanOrder_.size() == last - first) fanSize_ = int(fanOrder_.size());
+  } while (at != first && walked < edges);
+  if (at == first && walked == edges) fanSize_ = int(edges);
 }
 
 int VertexSplitter::cutBand(int position, int cut) const {
