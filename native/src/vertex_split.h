@@ -546,13 +546,12 @@ void VertexSplitter::codeFanExpansion(Coder& coder) {
     star_[fanOrder_[size_t(k)]].code = code;
     ++statistics_.codes[1][code - 1];
   };
-  int cuts = 0, firstCut = -1;
-  int cutAt[2] = {0, 0};  // the two cuts' fan positions
+  int cuts = 0;
+  int cutAt[2] = {0, 0};  // the cuts' fan positions, the first once cuts > 0
   uint8_t side;  // of the arc the walk is in
   const int next = fanNext(start);
   if (coder.bit(startCutModels_[bucketAt(start)], recorded(start) == 4)) {
-    cuts = 1;
-    firstCut = cutAt[0] = start;
+    cutAt[cuts++] = start;
     give(start, 4);
     // The arc after the cut: the next edge's side, or, when that is the
     // other cut, the opposite of the edge after it.
@@ -571,7 +570,7 @@ void VertexSplitter::codeFanExpansion(Coder& coder) {
     if ((cuts == 0 && left == 2) || (cuts == 1 && left == 1)) {
       cut = true;  // the cuts still missing must be the last edges
     } else if (cuts < 2) {
-      const int band = firstCut >= 0 ? cutBand(k, firstCut) : 0;
+      const int band = cuts > 0 ? cutBand(k, cutAt[0]) : 0;
       const bool longer = lengths_[fanOrder_[size_t(k)] - firstEdge] > meanLength_;
       int context = cuts;
       context = context * 2 + (sideAt(k) == side);
@@ -585,8 +584,7 @@ void VertexSplitter::codeFanExpansion(Coder& coder) {
       cut = coder.bit(fanCutModels_[context], recorded(k) == 4);
     }
     if (cut) {
-      cutAt[cuts] = k;
-      if (++cuts == 1) firstCut = k;
+      cutAt[cuts++] = k;
       side = uint8_t(3 - side);
     }
     give(k, cut ? 4 : side);
