@@ -79,12 +79,20 @@ class GrowingArray {
     if (capacity > capacity_) reallocate(capacity);
   }
   void push_back(T value) {
-    if (size_ == capacity_) grow();
+    if (size_ == capacity_) grow(1);
     data_[size_++] = value;
+  }
+  // Appends `count` values left for the caller to write through the
+  // returned pointer: one compare for all of them.
+  T* extend(size_t count) {
+    if (capacity_ - size_ < count) grow(count);
+    T* at = data_ + size_;
+    size_ += count;
+    return at;
   }
 
  private:
-  [[gnu::noinline]] void grow() { reallocate(std::max<size_t>(16, capacity_ * 2)); }
+  [[gnu::noinline]] void grow(size_t count) { reallocate(std::max<size_t>({16, capacity_ * 2, size_ + count})); }
   void reallocate(size_t capacity) {
     T* data = static_cast<T*>(std::malloc(capacity * sizeof(T)));
     // As std::vector's: an exception, or without exceptions (the

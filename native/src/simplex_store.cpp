@@ -43,11 +43,13 @@ uint32_t SimplexStore::add(int dimension, const uint32_t* vertices, uint8_t flag
   // Each slot joins the head of its vertex's list, as link() puts it, from
   // the vertex id at hand rather than read back from the pool.
   uint32_t* heads = heads_[dimension].data();
+  uint32_t* tuple = pool.vertices.extend(arity);
+  uint32_t* next = pool.next.extend(arity);
   const uint32_t firstSlot = simplex * uint32_t(arity);
   for (uint32_t i = 0; i < arity; ++i) {
     const uint32_t vertex = vertices[i];
-    pool.vertices.push_back(vertex);
-    pool.next.push_back(heads[vertex]);
+    tuple[i] = vertex;
+    next[i] = heads[vertex];
     heads[vertex] = firstSlot + i;
   }
   return simplex;

@@ -31,28 +31,33 @@ uint64_t othersKey(const uint32_t* others, int count) {
 
 // A key above every key that sortDistinctKeys() sorts.
 constexpr uint64_t kPaddingKey = ~uint64_t(0);
-constexpr int kRankedKeys = 8;
+constexpr int kNetworkKeys = 8;
 
 // Sorts keys[0..n) ascending. The keys are distinct, and when n is at most
-// kRankedKeys, keys[n..kRankedKeys) hold kPaddingKey: each key is then
-// placed at its rank (how many keys are smaller, counted over all
-// kRankedKeys, padding included, so that every loop runs a fixed count),
-// with no branch on the keys or on n, where an insertion sort mispredicts
-// about once per key.
+// kNetworkKeys, keys[n..kNetworkKeys) hold kPaddingKey, which sorts last: all
+// kNetworkKeys then go through a fixed network of 19 compare-exchanges
+// (Knuth's for eight inputs), minima and maxima with no branch on the keys
+// or on n, where an insertion sort mispredicts about once per key.
 void sortDistinctKeys(uint64_t* keys, int n) {
-  if (n > kRankedKeys) {
+  if (n > kNetworkKeys) {
     std::sort(keys, keys + n);
     return;
   }
-  // The padding keys all rank n and land on ranked[n].
-  uint64_t ranked[kRankedKeys + 1];
-  std::fill_n(ranked, kRankedKeys + 1, kPaddingKey);
-  for (int i = 0; i < kRankedKeys; ++i) {
-    int rank = 0;
-    for (int j = 0; j < kRankedKeys; ++j) rank += keys[j] < keys[i];
-    ranked[rank] = keys[i];
-  }
-  std::copy_n(ranked, kRankedKeys, keys);
+  static_assert(kNetworkKeys == 8);
+  uint64_t k[kNetworkKeys];
+  std::copy_n(keys, kNetworkKeys, k);
+  auto order = [&k](int a, int b) {
+    const uint64_t x = k[a], y = k[b];
+    k[a] = std::min(x, y);
+    k[b] = std::max(x, y);
+  };
+  order(0, 2), order(1, 3), order(4, 6), order(5, 7);
+  order(0, 4), order(1, 5), order(2, 6), order(3, 7);
+  order(0, 1), order(2, 3), order(4, 5), order(6, 7);
+  order(2, 4), order(3, 5);
+  order(1, 4), order(3, 6);
+  order(1, 2), order(3, 4), order(5, 6);
+  std::copy_n(k, kNetworkKeys, keys);
 }
 
 }  // namespace
@@ -402,13 +407,14 @@ void VertexSplitter::linkFans() {
 
 bool VertexSplitter::gatherClosedFan(uint32_t v) {
   constexpr int kMax = kLeanFanEdges;
-  static_assert(kMax >= kRankedKeys);
-  if (store_.hasIncident(3, v)) return false;
+  static_assert(kMax >= kNetworkKeys);
+  // A surface's store has no tetrahedra: its list heads are not read.
+  if (store_.size(3) > 0 && store_.hasIncident(3, v)) return false;
   // The edges, in canonical order (by their other vertex): keys of the
   // other vertex and the list position, sorted.
   const SimplexStore::Lists edges = store_.lists(1);
   uint64_t edgeKeys[kMax];
-  std::fill_n(edgeKeys, kRankedKeys, kPaddingKey);
+  std::fill_n(edgeKeys, kNetworkKeys, kPaddingKey);
   uint32_t edgeSlots[kMax];
   int n = 0;
   for (uint32_t slot = edges.heads[v]; slot != kNoSimplex; slot = edges.next[slot]) {
@@ -431,7 +437,7 @@ bool VertexSplitter::gatherClosedFan(uint32_t v) {
   // pairs, smaller first: keys of the pair and the list position, sorted.
   const SimplexStore::Lists triangles = store_.lists(2);
   uint64_t triangleKeys[kMax];
-  std::fill_n(triangleKeys, kRankedKeys, kPaddingKey);
+  std::fill_n(triangleKeys, kNetworkKeys, kPaddingKey);
   uint32_t triangleSlots[kMax];
   int t = 0;
   for (uint32_t slot = triangles.heads[v]; slot != kNoSimplex; slot = triangles.next[slot]) {
@@ -879,12 +885,25 @@ int VertexSplitter::predictFlip(int dimension, uint32_t simplex, const Entry& fr
   // orientation decisions): it is oriented as the fan triangle through v c
   // that stays at v, the one of its two neighbours on the fan whose arc
   // went to v.
+  // The two share the edge v c and nothing else (the fan triangle's third
+  // vertex is an old neighbour of v, the new triangle's is v2, at the end
+  // of its tuple), so the vote is the comparison of the orientations each
+  // induces on v c, as neighbourVote() would find it.
   if (fanExpansionCoded_) {
     const int before = fanPrevious(from.fanIndex);
     const int slot = slotSides_[size_t(before)] == 1 ? before : from.fanIndex;
-    const int vote = neighbourVote<3>(simplex, store_.parity(2, simplex), star_[slotTriangles_[size_t(slot)]].simplex);
-    voteClass = vote != 0;
-    return vote > 0;
+    const Entry& stays = star_[slotTriangles_[size_t(slot)]];
+    const uint32_t* theirs = store_.vertices(2, stays.simplex);
+    const int atV = stays.position, afterV = atV == 2 ? 0 : atV + 1, beforeV = atV == 0 ? 2 : atV - 1;
+    const int third = theirs[afterV] == from.others[0] ? beforeV : afterV;
+    const bool decided = !(store_.flags(2, stays.simplex) & SimplexStore::kUndecided);
+    const int flip = inducedSign(2, simplex, 2) == inducedSign(2, stays.simplex, third);
+#ifdef KDMESH_CHECK_VOTES
+    const int vote = neighbourVote<3>(simplex, store_.parity(2, simplex), stays.simplex);
+    if (vote != (decided ? (flip ? 1 : -1) : 0)) std::abort();
+#endif
+    voteClass = decided;
+    return decided && flip;
   }
   // Stars small enough to vote without the facet index (see around()).
   if (dimension == 2 && star_.size() * 2 <= kIndexedStar) {

@@ -644,7 +644,9 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int
     if (!toSecond) geometry_.adoptNeighbourhood(v2, v, !toFirst);
     else if (!toFirst) geometry_.adoptNeighbourhood(v, v2, false);
   }
-  for (int d = 1; d <= SimplexStore::kMaxDimension; ++d) store_.detach(d, v);
+  // A dimension without simplices has no list to empty.
+  for (int d = 1; d <= SimplexStore::kMaxDimension; ++d)
+    if (store_.size(d) > 0) store_.detach(d, v);
   if (star_[0].code == 4) {
     const uint32_t edge[2] = {v, v2};
     star_[0].added = store_.add(1, edge, 0);
