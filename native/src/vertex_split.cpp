@@ -46,10 +46,12 @@ void sortDistinctKeys(uint64_t* keys, int n) {
   static_assert(kNetworkKeys == 8);
   uint64_t k[kNetworkKeys];
   std::copy_n(keys, kNetworkKeys, k);
+  // By masks: GCC compiles std::min and std::max of these keys to branches.
   auto order = [&k](int a, int b) {
     const uint64_t x = k[a], y = k[b];
-    k[a] = std::min(x, y);
-    k[b] = std::max(x, y);
+    const uint64_t swap = (x ^ y) & (uint64_t(0) - uint64_t(y < x));
+    k[a] = x ^ swap;
+    k[b] = y ^ swap;
   };
   order(0, 2), order(1, 3), order(4, 6), order(5, 7);
   order(0, 4), order(1, 5), order(2, 6), order(3, 7);
@@ -383,7 +385,7 @@ void VertexSplitter::linkFans() {
   // Most stars (those of surfaces) have no edge in more than two
   // triangles: their links list every fan neighbour already.
   if (!crowdedFans()) {
-    indexFan();
+    indexFan(false);
     return;
   }
   fanSize_ = 0;
@@ -426,7 +428,23 @@ bool VertexSplitter::gatherClosedFan(uint32_t v) {
   if (n < 3) return false;
   sortDistinctKeys(edgeKeys, n);
   if (edgeTo_.size() < store_.vertexCapacity()) edgeTo_.resize(store_.vertexCapacity());
-  for (int e = 0; e < n; ++e) edgeTo_[edgeKeys[e] >> 8] = uint32_t(1 + e);
+  // The entries as gatherStar() leaves them (the triangles' below), then
+  // the links and the fan order as linkFans() and indexFan() make them.
+  star_.resize(size_t(1 + 2 * n));
+  StarEntry entry{};
+  entry.simplex = entry.copy = entry.added = kNoSimplex;
+  star_[0] = entry;
+  entry.links[0] = entry.links[1] = kNoSimplex;
+  for (int e = 0; e < n; ++e) {
+    const uint32_t other = uint32_t(edgeKeys[e] >> 8), slot = edgeSlots[edgeKeys[e] & 0xff];
+    edgeTo_[other] = uint32_t(1 + e);
+    StarEntry& edge = star_[size_t(1 + e)];
+    edge = entry;
+    edge.simplex = slot >> 1;
+    edge.dimension = 1;
+    edge.position = uint8_t(slot & 1);
+    edge.others[0] = other;
+  }
   // The star index of the edge to `vertex`, or kNoSimplex.
   auto edgeTo = [&](uint32_t vertex) {
     const uint32_t i = edgeTo_[vertex];
@@ -455,22 +473,6 @@ bool VertexSplitter::gatherClosedFan(uint32_t v) {
   }
   if (t != n) return false;
   sortDistinctKeys(triangleKeys, n);
-  // The entries as gatherStar() leaves them, then the links and the fan
-  // order as linkFans() and indexFan() make them.
-  star_.resize(size_t(1 + 2 * n));
-  StarEntry entry{};
-  entry.simplex = entry.copy = entry.added = kNoSimplex;
-  star_[0] = entry;
-  entry.links[0] = entry.links[1] = kNoSimplex;
-  for (int e = 0; e < n; ++e) {
-    const uint32_t slot = edgeSlots[edgeKeys[e] & 0xff];
-    StarEntry& edge = star_[size_t(1 + e)];
-    edge = entry;
-    edge.simplex = slot >> 1;
-    edge.dimension = 1;
-    edge.position = uint8_t(slot & 1);
-    edge.others[0] = uint32_t(edgeKeys[e] >> 8);
-  }
   // Each triangle links its two edges, in canonical order as linkFans()
   // does; a fan has two links per edge and no more. Which link is free is
   // counted per edge, not tested.
@@ -499,7 +501,9 @@ bool VertexSplitter::gatherClosedFan(uint32_t v) {
   if (!room) return false;
   begin_ = {0, 1, size_t(1 + n), size_t(1 + 2 * n), size_t(1 + 2 * n)};
   crowdedLinks_ = 0;
-  indexFan();
+  // n triangles linked 2n times, none of the n edges more than twice:
+  // every edge has both its links.
+  indexFan(true);
   if (fanSize_ == 0) return false;
 #ifdef KDMESH_CHECK_FANS
   // The general path must find the same star.
@@ -522,13 +526,14 @@ bool VertexSplitter::gatherClosedFan(uint32_t v) {
 
 // Numbers the edges around the fan when the star's edges form one closed
 // fan (each in two triangles, one cycle); fanSize_ is 0 otherwise.
-void VertexSplitter::indexFan() {
+void VertexSplitter::indexFan(bool everyEdgeLinkedTwice) {
   fanSize_ = 0;
   firstCut_ = -1;
   const size_t first = begin_[1], last = begin_[2];
   if (last - first < 3 || last - first > 255) return;
-  for (size_t i = first; i < last; ++i)
-    if (star_[i].links[1] == kNoSimplex) return;
+  if (!everyEdgeLinkedTwice)
+    for (size_t i = first; i < last; ++i)
+      if (star_[i].links[1] == kNoSimplex) return;
   // Links are mutual (linkFans() made each both ways, none dropped), so
   // the edge the walk came from is one of the two links and the next is
   // the other: their exclusive or without the previous one. Starting as
@@ -550,7 +555,7 @@ void VertexSplitter::indexFan() {
 int VertexSplitter::cutBand(int position, int cut) const {
   const int apart = std::abs(position - cut);
   const int distance = std::min(apart, fanSize_ - apart), half = fanSize_ / 2;
-  return distance >= half ? 4 : distance == half - 1 ? 3 : distance == half - 2 ? 2 : 1;
+  return std::clamp(distance - half + 4, 1, 4);  // 4 from half on, 3 and 2 just below
 }
 
 int VertexSplitter::fanSlot(const Entry& triangle) const {
@@ -891,19 +896,23 @@ int VertexSplitter::predictFlip(int dimension, uint32_t simplex, const Entry& fr
   // induces on v c, as neighbourVote() would find it.
   if (fanExpansionCoded_) {
     const int before = fanPrevious(from.fanIndex);
-    const int slot = slotSides_[size_t(before)] == 1 ? before : from.fanIndex;
+    const int at = from.fanIndex;
+    const int slot = at ^ ((at ^ before) & -int(slotSides_[size_t(before)] == 1));
     const Entry& stays = star_[slotTriangles_[size_t(slot)]];
     const uint32_t* theirs = store_.vertices(2, stays.simplex);
-    const int atV = stays.position, afterV = atV == 2 ? 0 : atV + 1, beforeV = atV == 0 ? 2 : atV - 1;
-    const int third = theirs[afterV] == from.others[0] ? beforeV : afterV;
+    // Positions by table and the third by a mask: which one holds c is a
+    // coin toss for the branch predictor.
+    static constexpr int kAfter[3] = {1, 2, 0}, kBefore[3] = {2, 0, 1};
+    const int afterV = kAfter[stays.position], beforeV = kBefore[stays.position];
+    const int third = afterV ^ ((afterV ^ beforeV) & -int(theirs[afterV] == from.others[0]));
     const bool decided = !(store_.flags(2, stays.simplex) & SimplexStore::kUndecided);
-    const int flip = inducedSign(2, simplex, 2) == inducedSign(2, stays.simplex, third);
+    const bool flip = inducedSign(2, simplex, 2) == inducedSign(2, stays.simplex, third);
 #ifdef KDMESH_CHECK_VOTES
     const int vote = neighbourVote<3>(simplex, store_.parity(2, simplex), stays.simplex);
     if (vote != (decided ? (flip ? 1 : -1) : 0)) std::abort();
 #endif
     voteClass = decided;
-    return decided && flip;
+    return decided & flip;
   }
   // Stars small enough to vote without the facet index (see around()).
   if (dimension == 2 && star_.size() * 2 <= kIndexedStar) {

@@ -204,7 +204,8 @@ class VertexSplitter {
   void classifyEdges();
   void orderCodes(bool geometric);
   void linkFans();
-  void indexFan();
+  // `everyEdgeLinkedTwice`: the caller knows every edge has both links.
+  void indexFan(bool everyEdgeLinkedTwice);
   // gatherStar() and linkFans() for a star that is one closed fan of
   // triangles and nothing else, of at most kLeanFanEdges edges (the star of
   // almost every split of a surface): the same entries, links and fan
@@ -247,7 +248,10 @@ class VertexSplitter {
   int cutBand(int position, int cut) const;
   // The fan positions after and before `position` around the closed fan
   // (a compare, not a division).
-  int fanNext(int position) const { return position + 1 == fanSize_ ? 0 : position + 1; }
+  int fanNext(int position) const {
+    const int next = position + 1;
+    return next & -int(next != fanSize_);
+  }
   int fanPrevious(int position) const { return (position == 0 ? fanSize_ : position) - 1; }
   // Codes every entry of the star one by one, in the order of orderCodes();
   // false when the codes contradict each other.
@@ -429,7 +433,7 @@ void VertexSplitter::decideOrientation(Coder& coder, int dimension, uint32_t sim
   const bool mispredicted = coder.bit(model, flip != predicted);
   flip = predicted ^ int(mispredicted);
   uint8_t& flags = store_.flags(dimension, simplex);
-  if (flip) flags ^= SimplexStore::kFlipped;
+  flags ^= uint8_t(flip * SimplexStore::kFlipped);
   flags &= uint8_t(~SimplexStore::kUndecided);
   if (!facets_[size_t(dimension)].empty()) countDecided(dimension, simplex);
   ++statistics_.orientationBits;
@@ -538,8 +542,13 @@ void VertexSplitter::codeFanExpansion(Coder& coder) {
   auto bucketAt = [&](int k) { return directionBucket(cosineAt(k)); };
   // The walk starts at the steepest edge, the surest of its side.
   int start = 0;
-  for (int k = 1; k < n; ++k)
-    if (std::fabs(cosineAt(k)) > std::fabs(cosineAt(start))) start = k;
+  double steepest = std::fabs(cosineAt(0));
+  for (int k = 1; k < n; ++k) {
+    const double steepness = std::fabs(cosineAt(k));
+    const bool steeper = steepness > steepest;  // a select, not a branch
+    start = steeper ? k : start;
+    steepest = steeper ? steepness : steepest;
+  }
   slotSides_.resize(size_t(n));
   // Each edge's code goes straight to its star entry.
   auto give = [&](int k, uint8_t code) {
@@ -567,7 +576,7 @@ void VertexSplitter::codeFanExpansion(Coder& coder) {
     const int after = fanNext(k);
     const int left = n - step;  // edges left, this one included
     bool cut = false;
-    if ((cuts == 0 && left == 2) || (cuts == 1 && left == 1)) {
+    if (cuts + left == 2) {  // no cut and two edges left, or one and one
       cut = true;  // the cuts still missing must be the last edges
     } else if (cuts < 2) {
       const int band = cuts > 0 ? cutBand(k, cutAt[0]) : 0;
@@ -652,14 +661,20 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int
     star_[0].added = store_.add(1, edge, 0);
     if (star_[0].added == kNoSimplex) return false;
   }
-  for (size_t i = 1; i < star_.size(); ++i) {
-    Entry& entry = star_[i];
-    const int d = entry.dimension;
-    // v stays v unless the code sends the simplex to v2: no branch on the code.
-    store_.setVertex(d, entry.simplex, entry.position, entry.code == 2 ? v2 : v);
-    if (d == 2) geometry_.forgetAcross(entry.simplex, entry.position);
-    store_.link(d, entry.simplex, entry.position);
-    if (entry.code < 3) continue;
+  // Each entry's simplex goes to v or v2 and joins its list there; those
+  // coded 3 or 4 then add their copy at v2 and, for 4, the simplex one
+  // dimension up, in star order. Of a fan expansion's entries only its two
+  // cut edges are, which it knows without testing each code.
+  auto relink = [&](size_t first, size_t last, int d) {
+    for (size_t i = first; i < last; ++i) {
+      const Entry& entry = star_[i];
+      // v stays v unless the code sends the simplex to v2: no branch on the code.
+      store_.setVertex(d, entry.simplex, entry.position, entry.code == 2 ? v2 : v);
+      if (d == 2) geometry_.forgetAcross(entry.simplex, entry.position);
+      store_.link(d, entry.simplex, entry.position);
+    }
+  };
+  auto addChildren = [&](Entry& entry, int d) {
     const uint8_t undecided = d >= 2 ? SimplexStore::kUndecided : 0;
     uint32_t tuple[5];
     std::copy(store_.vertices(d, entry.simplex), store_.vertices(d, entry.simplex) + d + 1, tuple);
@@ -672,6 +687,24 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int
       tuple[d + 1] = v2;
       entry.added = store_.add(d + 1, tuple, uint8_t(flipped | (d + 1 >= 2 ? SimplexStore::kUndecided : 0)));
       if (entry.added == kNoSimplex) return false;
+    }
+    return true;
+  };
+  if (fanExpansionCoded_) {
+    size_t next = begin_[1];
+    for (const uint32_t cut : fanCutEntries_) {
+      relink(next, cut + 1, 1);
+      if (!addChildren(star_[cut], 1)) return false;
+      next = cut + 1;
+    }
+    relink(next, begin_[2], 1);
+    relink(begin_[2], begin_[3], 2);
+  } else {
+    for (int d = 1; d <= SimplexStore::kMaxDimension; ++d) {
+      for (size_t i = begin_[size_t(d)]; i < begin_[size_t(d) + 1]; ++i) {
+        relink(i, i + 1, d);
+        if (star_[i].code >= 3 && !addChildren(star_[i], d)) return false;
+      }
     }
   }
 
