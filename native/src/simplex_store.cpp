@@ -29,32 +29,6 @@ void SimplexStore::setCapacity(int dimension, uint32_t maxSimplices, uint32_t ex
   if (labelled_) pool.labels.reserve(expected);
 }
 
-uint32_t SimplexStore::add(int dimension, const uint32_t* vertices, uint8_t flags, uint32_t label) {
-  Pool& pool = pool_[dimension];
-  const uint32_t simplex = uint32_t(pool.flags.size());
-  const size_t arity = size_t(dimension + 1);
-  // Slots are simplex * arity + position in 32 bits (a product, not a
-  // quotient: the arity is not known at compile time, and a division is
-  // slow).
-  if (simplex >= pool.capacity || uint64_t(simplex) * arity >= 0xfffffff0u) return kNoSimplex;
-  pool.flags.push_back(uint8_t(flags | kAlive));
-  if (labelled_) pool.labels.push_back(label);
-  ++live_[dimension];
-  // Each slot joins the head of its vertex's list, as link() puts it, from
-  // the vertex id at hand rather than read back from the pool.
-  uint32_t* heads = heads_[dimension].data();
-  uint32_t* tuple = pool.vertices.extend(arity);
-  uint32_t* next = pool.next.extend(arity);
-  const uint32_t firstSlot = simplex * uint32_t(arity);
-  for (uint32_t i = 0; i < arity; ++i) {
-    const uint32_t vertex = vertices[i];
-    tuple[i] = vertex;
-    next[i] = heads[vertex];
-    heads[vertex] = firstSlot + i;
-  }
-  return simplex;
-}
-
 void SimplexStore::kill(int dimension, uint32_t simplex) {
   pool_[dimension].flags[simplex] &= uint8_t(~kAlive);
   --live_[dimension];
