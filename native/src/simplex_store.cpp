@@ -38,12 +38,4 @@ bool SimplexStore::hasIncident(int dimension, uint32_t vertex) const {
   return forEachIncident(dimension, vertex, [](uint32_t, uint32_t) { return true; });
 }
 
-void SimplexStore::link(int dimension, uint32_t simplex, uint32_t position) {
-  Pool& pool = pool_[dimension];
-  const uint32_t slot = simplex * uint32_t(dimension + 1) + position;
-  const uint32_t vertex = pool.vertices[slot];
-  pool.next[slot] = heads_[dimension][vertex];
-  heads_[dimension][vertex] = slot;
-}
-
 }  // namespace kdmesh

@@ -199,8 +199,18 @@ class SimplexStore {
   bool labelled_ = false;
 };
 
-// Inline: the decoder adds a few simplices per vertex split.
-inline uint32_t SimplexStore::add(int dimension, const uint32_t* vertices, uint8_t flags, uint32_t label) {
+// Inline, as add(): a split relinks every simplex of its star.
+inline void SimplexStore::link(int dimension, uint32_t simplex, uint32_t position) {
+  Pool& pool = pool_[dimension];
+  const uint32_t slot = simplex * uint32_t(dimension + 1) + position;
+  const uint32_t vertex = pool.vertices[slot];
+  pool.next[slot] = heads_[dimension][vertex];
+  heads_[dimension][vertex] = slot;
+}
+
+// Inline, always (clang, building the WebAssembly module, left it a call):
+// the decoder adds a few simplices per vertex split.
+[[gnu::always_inline]] inline uint32_t SimplexStore::add(int dimension, const uint32_t* vertices, uint8_t flags, uint32_t label) {
   Pool& pool = pool_[dimension];
   const uint32_t simplex = uint32_t(pool.flags.size());
   const size_t arity = size_t(dimension + 1);
