@@ -107,6 +107,7 @@ void gatherStar(SimplexStore& store, uint32_t v, std::vector<StarEntry>& star,
   begin[0] = 0;
   for (int d = 1; d <= SimplexStore::kMaxDimension; ++d) {
     begin[size_t(d)] = star.size();
+    if (store.size(d) == 0) continue;  // a surface's tetrahedra: no list head to read
     store.forEachIncident(d, v, [&](uint32_t simplex, uint32_t position) {
       entry.simplex = simplex;
       entry.dimension = uint8_t(d);

@@ -629,8 +629,7 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int
   int cutEdges = 0;  // edges coded 4: an edge expansion has two
   bool codedThree = false;
   // The encoder's records come in canonical order.
-  constexpr bool kDecoding = std::is_same_v<std::decay_t<Oracle>, NoRecords>;
-  if constexpr (!kDecoding)
+  if constexpr (!std::is_same_v<std::decay_t<Oracle>, NoRecords>)
     for (Entry& entry : star_) entry.record = oracle();
   bool coded = false;
   fanExpansionCoded_ = false;
@@ -679,13 +678,13 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int
     const uint8_t undecided = d >= 2 ? SimplexStore::kUndecided : 0;
     uint32_t tuple[5];
     std::copy(store_.vertices(d, entry.simplex), store_.vertices(d, entry.simplex) + d + 1, tuple);
-    // Only the encoder's decimation flips edges (a twin's tuple order); the
-    // decoder's never are, so it skips loading a cut edge's flags, which
+    // Edges have no orientation, and nothing flips one (orientations are
+    // decided, and twins flipped by the decimation, from triangles up): a
+    // cut edge's children start unflipped without loading its flags, which
     // nothing else in the split touches.
-    const uint8_t flipped =
-        kDecoding && d == 1 ? 0 : uint8_t(store_.flags(d, entry.simplex) & SimplexStore::kFlipped);
+    const uint8_t flipped = d == 1 ? 0 : uint8_t(store_.flags(d, entry.simplex) & SimplexStore::kFlipped);
 #ifdef KDMESH_CHECK_VOTES
-    if (kDecoding && (store_.flags(d, entry.simplex) & SimplexStore::kFlipped) != flipped) std::abort();
+    if ((store_.flags(d, entry.simplex) & SimplexStore::kFlipped) != flipped) std::abort();
 #endif
     tuple[entry.position] = v2;
     entry.copy = store_.add(d, tuple, uint8_t(flipped | undecided));
