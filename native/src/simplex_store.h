@@ -122,10 +122,13 @@ class SimplexStore {
   }
 
   // Calls visit(simplex, position) for every live simplex of `dimension`
-  // holding `vertex`, unlinking killed ones on the way.
+  // holding `vertex`, unlinking killed ones on the way. The walks, and
+  // detach(), of a dimension without simplices (a surface's tetrahedra)
+  // read no list head: a cache miss each, per vertex split.
   template <class Visit>
   void forEachIncident(int dimension, uint32_t vertex, Visit&& visit) {
     Pool& pool = pool_[dimension];
+    if (pool.flags.size() == 0) return;
     const uint32_t arity = uint32_t(dimension + 1);
     uint32_t* link = &heads_[dimension][vertex];
     while (*link != kNoSimplex) {
@@ -147,6 +150,7 @@ class SimplexStore {
   template <class Visit>
   bool forEachIncident(int dimension, uint32_t vertex, Visit&& visit) const {
     const Pool& pool = pool_[dimension];
+    if (pool.flags.size() == 0) return false;
     const uint32_t arity = uint32_t(dimension + 1);
     for (uint32_t slot = heads_[dimension][vertex]; slot != kNoSimplex; slot = pool.next[slot]) {
       const uint32_t simplex = slot / arity;
@@ -180,7 +184,9 @@ class SimplexStore {
 
   // Empties `vertex`'s list of `dimension` without touching the simplices;
   // the caller relinks every slot it keeps with link().
-  void detach(int dimension, uint32_t vertex) { heads_[dimension][vertex] = kNoSimplex; }
+  void detach(int dimension, uint32_t vertex) {
+    if (size(dimension) > 0) heads_[dimension][vertex] = kNoSimplex;
+  }
   void link(int dimension, uint32_t simplex, uint32_t position);
 
  private:

@@ -107,7 +107,6 @@ void gatherStar(SimplexStore& store, uint32_t v, std::vector<StarEntry>& star,
   begin[0] = 0;
   for (int d = 1; d <= SimplexStore::kMaxDimension; ++d) {
     begin[size_t(d)] = star.size();
-    if (store.size(d) == 0) continue;  // a surface's tetrahedra: no list head to read
     store.forEachIncident(d, v, [&](uint32_t simplex, uint32_t position) {
       entry.simplex = simplex;
       entry.dimension = uint8_t(d);
@@ -386,7 +385,7 @@ void VertexSplitter::linkFans() {
   // Most stars (those of surfaces) have no edge in more than two
   // triangles: their links list every fan neighbour already.
   if (!crowdedFans()) {
-    indexFan(false);
+    indexFan();
     return;
   }
   fanSize_ = 0;
@@ -411,8 +410,7 @@ void VertexSplitter::linkFans() {
 bool VertexSplitter::gatherClosedFan(uint32_t v) {
   constexpr int kMax = kLeanFanEdges;
   static_assert(kMax >= kNetworkKeys);
-  // A surface's store has no tetrahedra: its list heads are not read.
-  if (store_.size(3) > 0 && store_.hasIncident(3, v)) return false;
+  if (store_.hasIncident(3, v)) return false;
   // The edges, in canonical order (by their other vertex): keys of the
   // other vertex and the list position, sorted.
   const SimplexStore::Lists edges = store_.lists(1);
@@ -502,9 +500,7 @@ bool VertexSplitter::gatherClosedFan(uint32_t v) {
   if (!room) return false;
   begin_ = {0, 1, size_t(1 + n), size_t(1 + 2 * n), size_t(1 + 2 * n)};
   crowdedLinks_ = 0;
-  // n triangles linked 2n times, none of the n edges more than twice:
-  // every edge has both its links.
-  indexFan(true);
+  indexFan();
   if (fanSize_ == 0) return false;
 #ifdef KDMESH_CHECK_FANS
   // The general path must find the same star.
@@ -527,23 +523,22 @@ bool VertexSplitter::gatherClosedFan(uint32_t v) {
 
 // Numbers the edges around the fan when the star's edges form one closed
 // fan (each in two triangles, one cycle); fanSize_ is 0 otherwise.
-void VertexSplitter::indexFan(bool everyEdgeLinkedTwice) {
+void VertexSplitter::indexFan() {
   fanSize_ = 0;
   firstCut_ = -1;
   const size_t first = begin_[1], last = begin_[2];
   if (last - first < 3 || last - first > 255) return;
-  if (!everyEdgeLinkedTwice)
-    for (size_t i = first; i < last; ++i)
-      if (star_[i].links[1] == kNoSimplex) return;
   // Links are mutual (linkFans() made each both ways, none dropped), so
   // the edge the walk came from is one of the two links and the next is
   // the other: their exclusive or without the previous one. Starting as
-  // if from links[1] walks on to links[0].
+  // if from links[1] walks on to links[0]. An edge with one link ends the
+  // walk (no closed fan); one the walk does not reach leaves it short.
   const size_t edges = last - first;
   fanOrder_.resize(edges);
   uint32_t previous = star_[first].links[1], at = uint32_t(first);
   size_t walked = 0;
   do {
+    if (star_[at].links[1] == kNoSimplex) return;
     star_[at].fanIndex = uint8_t(walked);
     fanOrder_[walked++] = at;
     const uint32_t next = star_[at].links[0] ^ star_[at].links[1] ^ previous;

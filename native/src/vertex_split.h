@@ -204,8 +204,7 @@ class VertexSplitter {
   void classifyEdges();
   void orderCodes(bool geometric);
   void linkFans();
-  // `everyEdgeLinkedTwice`: the caller knows every edge has both links.
-  void indexFan(bool everyEdgeLinkedTwice);
+  void indexFan();
   // gatherStar() and linkFans() for a star that is one closed fan of
   // triangles and nothing else, of at most kLeanFanEdges edges (the star of
   // almost every split of a surface): the same entries, links and fan
@@ -653,9 +652,7 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int
     if (!toSecond) geometry_.adoptNeighbourhood(v2, v, !toFirst);
     else if (!toFirst) geometry_.adoptNeighbourhood(v, v2, false);
   }
-  // A dimension without simplices has no list to empty.
-  for (int d = 1; d <= SimplexStore::kMaxDimension; ++d)
-    if (store_.size(d) > 0) store_.detach(d, v);
+  for (int d = 1; d <= SimplexStore::kMaxDimension; ++d) store_.detach(d, v);
   if (star_[0].code == 4) {
     const uint32_t edge[2] = {v, v2};
     star_[0].added = store_.add(1, edge, 0);
@@ -707,11 +704,10 @@ bool VertexSplitter::split(Coder& coder, uint32_t v, uint32_t v2, int level, int
     relink(next, begin_[2], 1);
     relink(begin_[2], begin_[3], 2);
   } else {
-    for (int d = 1; d <= SimplexStore::kMaxDimension; ++d) {
-      for (size_t i = begin_[size_t(d)]; i < begin_[size_t(d) + 1]; ++i) {
-        relink(i, i + 1, d);
-        if (star_[i].code >= 3 && !addChildren(star_[i], d)) return false;
-      }
+    for (size_t i = 1; i < star_.size(); ++i) {
+      const int d = star_[i].dimension;
+      relink(i, i + 1, d);
+      if (star_[i].code >= 3 && !addChildren(star_[i], d)) return false;
     }
   }
 
