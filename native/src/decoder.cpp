@@ -182,6 +182,7 @@ struct Decoder::State {
         continue;
       }
       if (cursor < cells.size()) {
+        prefetchNeighbourhoods(cells, cursor, cells.size());
         if (!splitCell(cells[cursor++]))
           return Status::error(ErrorCode::CorruptChunk,
                                where + ": inconsistent connectivity codes or a label outside the table");
@@ -325,9 +326,23 @@ struct Decoder::State {
     if (nextAfterGeometry == header.vertexCount) normals = {};
   }
 
+  // Streams coded for fast decoding, at every kPrefetchBatch-th cell of a
+  // list: the neighbourhoods of the vertices of that cell and the next
+  // ones, whose predictions come soon, are prefetched
+  // (PositionPredictor::prefetchNeighbourhoods()).
+  static constexpr size_t kPrefetchBatch = 32;
+  void prefetchNeighbourhoods(const LargeArray<Cell>& list, size_t at, size_t end) {
+    if (at % kPrefetchBatch != 0 || !connectivity || !predictor->fastDecode()) return;
+    uint32_t vertices[kPrefetchBatch];
+    const size_t count = std::min(kPrefetchBatch, end - at);
+    for (size_t k = 0; k < count; ++k) vertices[k] = list[at + k].vertex;
+    predictor->prefetchNeighbourhoods(vertices, count);
+  }
+
   void refineSingles(size_t begin, size_t end) {
     const int axis = schedule->axis[size_t(level)];
     for (size_t i = begin; i < end; ++i) {
+      prefetchNeighbourhoods(singles, i, end);
       Cell& cell = singles[i];
       const bool upperHalf =
           connectivity ? !predictor->codeSingle(coder, *counts, cell.vertex, level,

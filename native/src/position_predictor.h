@@ -170,6 +170,14 @@ class PositionPredictor {
   [[gnu::noinline]] bool codeSingleAlongAxis(Coder& coder, CountCoder& counts, uint32_t vertex, int level,
                                              bool parentOneSided, bool inFirstHalf);
 
+  // Walks the edge lists of `count` vertices whose predictions come soon
+  // and prefetches their neighbours' cell centres, so that the walks of
+  // those predictions find both in cache. A walk is a chain of dependent
+  // loads, which the processor overlaps only with work that does not wait
+  // on it: here, the walks of the other vertices; in the decoding loop,
+  // nothing.
+  void prefetchNeighbourhoods(const uint32_t* vertices, size_t count) const;
+
   // A split left `isolated` in no simplex and its cell's other half, the
   // vertex `sibling`, with the simplices (or both in none: `sibling` is
   // then the isolated vertex that split, whose proxy passes on). A vertex
