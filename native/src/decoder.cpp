@@ -329,10 +329,13 @@ struct Decoder::State {
   // Streams coded for fast decoding, at every kPrefetchBatch-th cell of a
   // list: the neighbourhoods of the vertices of that cell and the next
   // ones, whose predictions come soon, are prefetched
-  // (PositionPredictor::prefetchNeighbourhoods()).
+  // (PositionPredictor::prefetchNeighbourhoods()). Only at geometric
+  // levels: there the predictions are made, and every vertex has a cell
+  // centre (those split apart at the coincident levels after them have
+  // none).
   static constexpr size_t kPrefetchBatch = 32;
   void prefetchNeighbourhoods(const LargeArray<Cell>& list, size_t at, size_t end) {
-    if (at % kPrefetchBatch != 0 || !connectivity || !predictor->fastDecode()) return;
+    if (at % kPrefetchBatch != 0 || level >= schedule->levels || !connectivity || !predictor->fastDecode()) return;
     uint32_t vertices[kPrefetchBatch];
     const size_t count = std::min(kPrefetchBatch, end - at);
     for (size_t k = 0; k < count; ++k) vertices[k] = list[at + k].vertex;

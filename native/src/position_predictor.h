@@ -175,7 +175,8 @@ class PositionPredictor {
   // those predictions find both in cache. A walk is a chain of dependent
   // loads, which the processor overlaps only with work that does not wait
   // on it: here, the walks of the other vertices; in the decoding loop,
-  // nothing.
+  // nothing. Their neighbours must have cells (place()), as for the
+  // predictions.
   void prefetchNeighbourhoods(const uint32_t* vertices, size_t count) const;
 
   // A split left `isolated` in no simplex and its cell's other half, the
