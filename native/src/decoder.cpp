@@ -182,7 +182,7 @@ struct Decoder::State {
         continue;
       }
       if (cursor < cells.size()) {
-        prefetchNeighbourhoods(cells, cursor, cells.size());
+        prefetchNeighbourhoods(cells, cursor);
         if (!splitCell(cells[cursor++]))
           return Status::error(ErrorCode::CorruptChunk,
                                where + ": inconsistent connectivity codes or a label outside the table");
@@ -327,17 +327,19 @@ struct Decoder::State {
   }
 
   // Streams coded for fast decoding, at every kPrefetchBatch-th cell of a
-  // list: the neighbourhoods of the vertices of that cell and the next
-  // ones, whose predictions come soon, are prefetched
-  // (PositionPredictor::prefetchNeighbourhoods()). Only at geometric
+  // level's list: the neighbourhoods of the vertices of that cell and the
+  // next ones, whose predictions come soon, are prefetched
+  // (PositionPredictor::prefetchNeighbourhoods()). Batches are aligned in
+  // the list, not to the splits a chunk holds, so a chunk that ends in a
+  // batch leaves the rest of it prefetched for the next. Only at geometric
   // levels: there the predictions are made, and every vertex has a cell
   // centre (those split apart at the coincident levels after them have
   // none).
   static constexpr size_t kPrefetchBatch = 32;
-  void prefetchNeighbourhoods(const LargeArray<Cell>& list, size_t at, size_t end) {
+  void prefetchNeighbourhoods(const LargeArray<Cell>& list, size_t at) {
     if (at % kPrefetchBatch != 0 || level >= schedule->levels || !connectivity || !predictor->fastDecode()) return;
     uint32_t vertices[kPrefetchBatch];
-    const size_t count = std::min(kPrefetchBatch, end - at);
+    const size_t count = std::min(kPrefetchBatch, list.size() - at);
     for (size_t k = 0; k < count; ++k) vertices[k] = list[at + k].vertex;
     predictor->prefetchNeighbourhoods(vertices, count);
   }
@@ -345,7 +347,7 @@ struct Decoder::State {
   void refineSingles(size_t begin, size_t end) {
     const int axis = schedule->axis[size_t(level)];
     for (size_t i = begin; i < end; ++i) {
-      prefetchNeighbourhoods(singles, i, end);
+      prefetchNeighbourhoods(singles, i);
       Cell& cell = singles[i];
       const bool upperHalf =
           connectivity ? !predictor->codeSingle(coder, *counts, cell.vertex, level,
