@@ -291,8 +291,20 @@ void decimate(SimplexStore& store, const std::vector<VertexSplitIds>& splits,
   std::vector<uint8_t> reversed;
   std::vector<uint32_t> reversedLabels;
 
+  // Every kPrefetchBatch merges, the stars of the next ones' two vertices
+  // are prefetched (SimplexStore::prefetchStars()).
+  constexpr size_t kPrefetchBatch = 32;
+  uint32_t comingVertices[2 * kPrefetchBatch];
   for (size_t k = splits.size(); k-- > 0;) {
     if (progress && (k & 0xffff) == 0) progress(1.0 - double(k) / double(splits.size()));
+    if ((splits.size() - 1 - k) % kPrefetchBatch == 0) {
+      size_t count = 0;
+      for (size_t j = k + 1; j-- > 0 && count < 2 * kPrefetchBatch;) {
+        comingVertices[count++] = splits[j].kept;
+        comingVertices[count++] = splits[j].added;
+      }
+      store.prefetchStars(comingVertices, count);
+    }
     const uint32_t v1 = splits[k].kept, v2 = splits[k].added;
     // A simplex of v2 with v1 loses v2 and its face without v2 holds v1;
     // one without v1 takes v1 for v2 and its twin, if any, holds v1. Both

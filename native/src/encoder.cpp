@@ -140,7 +140,9 @@ class ChunkWriter {
 // non-empty half of a geometric split, single(level, parentOneSided,
 // inFirstHalf, id) for one-vertex cells, named(keyIndex, id) when a vertex
 // gets its final id, splitDone() after each split, and levelDone(level,
-// cells) after the last split of each level, whose cells it counts.
+// cells) after the last split of each level, whose cells it counts. At
+// geometric levels, coming(ids, count) precedes every 32nd cell of each
+// list with the vertices of that cell and the next ones, for prefetching.
 template <class Visitor>
 void traverseKdTree(const std::vector<KdKey>& keys, const SplitSchedule& schedule,
                     bool coincidentLevels, Visitor&& visitor) {
@@ -152,6 +154,15 @@ void traverseKdTree(const std::vector<KdKey>& keys, const SplitSchedule& schedul
   struct Single {
     uint32_t key, id;
     bool parentOneSided;
+  };
+  // The vertices of the kComingBatch cells (or one-vertex cells) of a
+  // geometric level's list from `at` on go to visitor.coming().
+  static constexpr size_t kComingBatch = 32;
+  auto announce = [&visitor](const auto& list, size_t at) {
+    uint32_t ids[kComingBatch];
+    const size_t count = std::min(kComingBatch, list.size() - at);
+    for (size_t k = 0; k < count; ++k) ids[k] = list[at + k].id;
+    visitor.coming(ids, count);
   };
   const uint32_t n = uint32_t(keys.size());
   LargeArray<Cell> cells, children;
@@ -172,7 +183,9 @@ void traverseKdTree(const std::vector<KdKey>& keys, const SplitSchedule& schedul
     const size_t oldSingles = singles.size();
     const size_t singleLevelEnd = geometric ? oldSingles : 0;
     children.clear();
-    for (const Cell& cell : cells) {
+    for (size_t c = 0; c < cells.size(); ++c) {
+      const Cell& cell = cells[c];
+      if (geometric && c % kComingBatch == 0) announce(cells, c);
       const uint32_t population = cell.end - cell.begin;
       const uint32_t split =
           geometric ? uint32_t(std::partition_point(keys.begin() + cell.begin, keys.begin() + cell.end,
@@ -204,6 +217,7 @@ void traverseKdTree(const std::vector<KdKey>& keys, const SplitSchedule& schedul
       visitor.splitDone();
     }
     for (size_t i = 0; i < singleLevelEnd; ++i) {
+      if (i % kComingBatch == 0) announce(singles, i);
       Single& single = singles[i];
       visitor.single(level, single.parentOneSided, ((keys[single.key] >> bit) & 1) == 0, single.id);
       single.parentOneSided = true;
@@ -325,6 +339,7 @@ EncodeResult encodeStream(const Complex& complex, const EncodeOptions& options, 
       }
       void placed(uint32_t, const uint32_t*, int) {}
       void single(int, bool, bool, uint32_t) {}
+      void coming(const uint32_t*, size_t) {}
       void named(uint32_t key, uint32_t id) { ids[vertexOfKey[key]] = id; }
       void splitDone() {}
       void levelDone(int, uint32_t) {}
@@ -451,6 +466,10 @@ EncodeResult encodeStream(const Complex& complex, const EncodeOptions& options, 
         predictor.codeSingle(coder, counts, id, level, parentOneSided, inFirstHalf);
       else
         counts.codeSingle(coder, level, parentOneSided, inFirstHalf);
+    }
+    // Fast streams: the predictions of these vertices come soon.
+    void coming(const uint32_t* ids, size_t count) {
+      if (connectivity && header.fastDecode) predictor.prefetchNeighbourhoods(ids, count);
     }
     void named(uint32_t, uint32_t) {}
     void splitDone() { chunks.splitDone(); }

@@ -164,6 +164,11 @@ class SimplexStore {
     return false;
   }
   bool hasIncident(int dimension, uint32_t vertex) const;
+  // Walks the lists of `count` vertices whose stars are gathered soon and
+  // prefetches their simplices' tuples and flags. Each walk is a chain of
+  // dependent loads; the walks of different vertices overlap here, where a
+  // star's gathering waits on each step in turn. Reads only.
+  void prefetchStars(const uint32_t* vertices, size_t count) const;
 
   // One dimension's incidence lists as plain arrays, for the hottest walks:
   // a loop over local pointers keeps them in registers, where a walk
