@@ -532,24 +532,31 @@ bool PositionPredictor::contextsOf(uint32_t vertex, int level, SingleContexts& c
 
 void PositionPredictor::prefetchNeighbourhoods(const uint32_t* vertices, size_t count) const {
   const SimplexStore::Lists edges = store_.lists(1);
-  // WebAssembly has no prefetch: there the centres are loaded, into a sum
-  // that only a volatile store reads, which brings their lines in all the
-  // same (loads that nothing waits on overlap as prefetches do).
-  [[maybe_unused]] double loaded = 0;
+  // The walks leave a result in a volatile store: a loop whose only
+  // effects are prefetches may otherwise be deleted (C++ lets the compiler
+  // assume that such a loop ends, and a prefetch changes nothing).
+  // Natively they count their steps. WebAssembly has no prefetch: there
+  // they add up the centres, whose loads bring their lines in all the same
+  // (loads that nothing waits on overlap as prefetches do).
+  [[maybe_unused]] uint32_t steps = 0;
+  [[maybe_unused]] double sum = 0;
   for (size_t i = 0; i < count; ++i) {
     const uint32_t vertex = vertices[i];
     if (vertex >= store_.vertexCapacity()) continue;
     for (uint32_t slot = edges.heads[vertex]; slot != kNoSimplex; slot = edges.next[slot]) {
       const double* centre = centres_.data() + size_t(edges.vertices[slot ^ 1]) * 3;
 #ifdef __wasm__
-      loaded += *centre;
+      sum += *centre;
 #else
       __builtin_prefetch(centre);
+      ++steps;
 #endif
     }
   }
 #ifdef __wasm__
-  [[maybe_unused]] volatile double sink = loaded;
+  [[maybe_unused]] volatile double walked = sum;
+#else
+  [[maybe_unused]] volatile uint32_t walked = steps;
 #endif
 }
 
