@@ -141,8 +141,9 @@ class ChunkWriter {
 // inFirstHalf, id) for one-vertex cells, named(keyIndex, id) when a vertex
 // gets its final id, splitDone() after each split, and levelDone(level,
 // cells) after the last split of each level, whose cells it counts. At
-// geometric levels, coming(ids, count) precedes every 32nd cell of each
-// list with the vertices of that cell and the next ones, for prefetching.
+// geometric levels, coming(ids, count) precedes every kComingBatch-th cell
+// of each list with the vertices of that cell and the next ones, for
+// prefetching.
 template <class Visitor>
 void traverseKdTree(const std::vector<KdKey>& keys, const SplitSchedule& schedule,
                     bool coincidentLevels, Visitor&& visitor) {
